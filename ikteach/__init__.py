@@ -1,0 +1,28 @@
+"""ikteach: inverse kinematics for a computer-animation course.
+
+Importing ikteach switches JAX to 64-bit floats, so every result is float64.
+"""
+import jax
+
+jax.config.update("jax_enable_x64", True)
+
+from .chain import Chain, planar_chain, serial_chain, reach  # noqa: E402
+from .kinematics import fk, joint_positions, joint_frames, rotation_about  # noqa: E402
+from .jacobian import jacobian, jacobian_autodiff, jacobian_fd  # noqa: E402
+from .jt import jt_step, optimal_alpha  # noqa: E402
+from .pinv import pinv_step  # noqa: E402
+from .dls import dls_step, dls_step_normal  # noqa: E402
+from .limits import clamp_error, cap_step  # noqa: E402
+from .solve import solve, Result, Trace, STATUSES, METHODS  # noqa: E402
+from .batch import solve_batch, BatchResult  # noqa: E402
+
+__all__ = [
+    "Chain", "planar_chain", "serial_chain", "reach",
+    "fk", "joint_positions", "joint_frames", "rotation_about",
+    "jacobian", "jacobian_autodiff", "jacobian_fd",
+    "jt_step", "optimal_alpha", "pinv_step", "dls_step", "dls_step_normal",
+    "clamp_error", "cap_step",
+    "solve", "Result", "Trace", "STATUSES", "METHODS",
+    "solve_batch", "BatchResult",
+]
+__version__ = "0.1.0"

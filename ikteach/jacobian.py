@@ -1,0 +1,33 @@
+"""The Jacobian J = dx/dtheta, three ways: geometric, automatic and finite differences."""
+import jax
+import jax.numpy as jnp
+
+from .kinematics import fk, joint_frames
+
+
+def jacobian(arm, theta, full=False):
+    """Geometric Jacobian: column i is w_i x (p_e - p_i).
+
+    Shape (d, n). With full=True the angular rows w_i are appended:
+    (6, n) for a spatial chain, (3, n) for a planar arm (x, y and the angle about z).
+    """
+    positions, axes, _ = joint_frames(arm, theta)
+    linear = jnp.cross(axes, positions[-1] - positions[:-1]).T
+    if not full:
+        return linear[: arm.dim]
+    if arm.dim == 2:
+        return jnp.vstack([linear[:2], axes.T[2:]])
+    return jnp.vstack([linear, axes.T])
+
+
+def jacobian_autodiff(arm, theta):
+    """J = dF/dtheta by forward-mode automatic differentiation (jax.jacfwd of fk)."""
+    return jax.jacfwd(lambda t: fk(arm, t))(jnp.asarray(theta, dtype=float))
+
+
+def jacobian_fd(arm, theta, h=1e-6):
+    """J by central differences: column i = (F(theta + h e_i) - F(theta - h e_i)) / 2h."""
+    theta = jnp.asarray(theta, dtype=float)
+    steps = h * jnp.eye(theta.shape[0])
+    columns = jax.vmap(lambda s: (fk(arm, theta + s) - fk(arm, theta - s)) / (2 * h))(steps)
+    return columns.T

@@ -1,0 +1,255 @@
+"""The IK loop: repeat theta <- theta + step(J(theta), e(theta)) until a stop rule fires.
+
+Each iteration, at the current theta:
+  1. e = target - F(theta); record theta and ||e|| in the trace;
+  2. stop "converged" if ||e|| < tol (checked before any step is taken);
+  3. stop "stalled" if the last step had sum |delta_theta_i| < stall_tol (out of reach);
+  4. stop "max_iter" after max_iter steps;
+  5. otherwise delta_theta = cap(step(J, clamp(e))); a non-finite step stops "diverged"
+     and keeps the last finite theta.
+"""
+import dataclasses
+import inspect
+from functools import partial
+from typing import Callable, NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from ._validate import as_array, as_count, as_number
+from .chain import Chain, reach
+from .dls import dls_step
+from .jacobian import jacobian
+from .jt import jt_step
+from .kinematics import fk
+from .limits import cap_step, clamp_error
+from .pinv import DEFAULT_RCOND, pinv_step
+
+STATUSES = ("running", "converged", "stalled", "max_iter", "diverged")
+RUNNING, CONVERGED, STALLED, MAX_ITER, DIVERGED = range(5)
+
+DEFAULT_DAMPING = 0.5
+STALL_FRACTION = 1e-5  # default stall_tol = STALL_FRACTION * total link length
+
+
+class Settings(NamedTuple):
+    """Numbers the loop reads (traced, so changing them does not recompile)."""
+    tol: float
+    damping: float
+    rcond: float
+    clamp: float      # D_max; inf for no clamp
+    max_step: float   # per-joint cap in radians; inf for none
+    stall_tol: float  # 0 disables the stall stop
+
+
+def _jt(J, e, s):
+    return jt_step(J, e)
+
+
+def _pinv(J, e, s):
+    return pinv_step(J, e, s.rcond)
+
+
+def _dls(J, e, s):
+    return dls_step(J, e, s.damping)
+
+
+METHODS = {"jt": _jt, "pinv": _pinv, "dls": _dls}
+
+
+@dataclasses.dataclass(frozen=True)
+class UserStep:
+    """A step function step(J, e) -> delta_theta given by the user."""
+    fn: Callable
+
+    def __call__(self, J, e, s):
+        return self.fn(J, e)
+
+
+@dataclasses.dataclass(frozen=True)
+class Trace:
+    """theta[k] and error[k] = ||e|| at iteration k; entry 0 is the start."""
+    theta: np.ndarray
+    error: np.ndarray
+
+
+@dataclasses.dataclass(frozen=True)
+class Result:
+    theta: np.ndarray
+    status: str
+    iterations: int
+    error: float
+    trace: Trace
+
+    @property
+    def converged(self):
+        return self.status == "converged"
+
+    def __repr__(self):
+        return (f"Result(status={self.status!r}, iterations={self.iterations}, "
+                f"error={self.error:.3g}, theta={np.round(self.theta, 4).tolist()})")
+
+
+class State(NamedTuple):
+    i: jax.Array
+    theta: jax.Array
+    error: jax.Array
+    last_step: jax.Array
+    status: jax.Array
+    trace_theta: jax.Array
+    trace_error: jax.Array
+
+
+def position_error(arm, target, theta):
+    """e = target - F(theta)."""
+    return target - fk(arm, theta)
+
+
+def _advance(step, arm, target, settings, max_iter, state):
+    """One pass of the loop described in the module docstring."""
+    e = position_error(arm, target, state.theta)
+    err = jnp.linalg.norm(e)
+    trace_error = state.trace_error.at[state.i].set(err) if state.trace_error.size else state.trace_error
+    status = jnp.select(
+        [~jnp.isfinite(err), err < settings.tol,
+         (state.i > 0) & (state.last_step < settings.stall_tol), state.i >= max_iter],
+        [DIVERGED, CONVERGED, STALLED, MAX_ITER], RUNNING)
+    J = jacobian(arm, state.theta)
+    delta = jnp.asarray(step(J, clamp_error(e, settings.clamp), settings))
+    if delta.shape != state.theta.shape:
+        raise ValueError(f"method: the step function returned shape {delta.shape}, "
+                         f"expected {state.theta.shape} (one entry per joint)")
+    delta = cap_step(delta.astype(state.theta.dtype), settings.max_step)
+    new_theta = state.theta + delta
+    finite = jnp.all(jnp.isfinite(new_theta))
+    status = jnp.where((status == RUNNING) & ~finite, DIVERGED, status)
+    take = status == RUNNING
+    i = jnp.where(take, state.i + 1, state.i)
+    theta = jnp.where(take, new_theta, state.theta)
+    trace_theta = state.trace_theta
+    if trace_theta.size:
+        trace_theta = jnp.where(take, trace_theta.at[i].set(new_theta), trace_theta)
+    return State(i, theta, err, jnp.where(take, jnp.sum(jnp.abs(delta)), state.last_step),
+                 status, trace_theta, trace_error)
+
+
+def _initial_state(theta0, max_iter, record):
+    n = theta0.shape[0]
+    rows = max_iter + 1 if record else 0
+    trace_theta = jnp.zeros((rows, n)).at[0].set(theta0) if record else jnp.zeros((0, n))
+    return State(jnp.asarray(0), theta0, jnp.asarray(jnp.inf), jnp.asarray(jnp.inf),
+                 jnp.asarray(RUNNING), trace_theta, jnp.zeros((rows,)))
+
+
+def run_loop(step, arm, target, theta0, settings, max_iter, record):
+    """The loop as a lax.while_loop (traceable: used under jit and vmap)."""
+    body = partial(_advance, step, arm, target, settings, max_iter)
+    return jax.lax.while_loop(lambda s: s.status == RUNNING, body,
+                              _initial_state(theta0, max_iter, record))
+
+
+_run_jit = jax.jit(run_loop, static_argnames=("step", "max_iter", "record"))
+
+
+def _run_eager(step, arm, target, theta0, settings, max_iter, record):
+    """The same loop, one Python iteration at a time, for step functions JAX cannot trace."""
+    state = _initial_state(theta0, max_iter, record)
+    while int(state.status) == RUNNING:
+        state = _advance(step, arm, target, settings, max_iter, state)
+    return state
+
+
+def _traceable(step, n_rows, n_joints, settings):
+    """Can JAX trace the step function (pure jax.numpy), or does it need eager execution?"""
+    J = jax.ShapeDtypeStruct((n_rows, n_joints), jnp.float64)
+    e = jax.ShapeDtypeStruct((n_rows,), jnp.float64)
+    try:
+        jax.eval_shape(lambda J, e: step(J, e, settings), J, e)
+    except Exception:
+        return False
+    return True
+
+
+def resolve_method(method):
+    """A method name or a step function step(J, e) -> the loop's step(J, e, settings)."""
+    if isinstance(method, str):
+        if method not in METHODS:
+            raise ValueError(f"method: expected one of {sorted(METHODS)} or a function "
+                             f"step(J, e) -> delta_theta, got {method!r}")
+        return METHODS[method]
+    if callable(method):
+        try:
+            inspect.signature(method).bind(None, None)
+        except TypeError:
+            raise ValueError("method: a step function must accept two arguments (J, e)") from None
+        except ValueError:
+            pass  # builtins without a signature
+        return UserStep(method)
+    raise ValueError(f"method: expected one of {sorted(METHODS)} or a function "
+                     f"step(J, e) -> delta_theta, got {method!r:.80}")
+
+
+def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, max_step,
+                  stall_tol, batch=False):
+    """Validate everything solve/solve_batch take; returns (target, theta0, settings, max_iter).
+
+    With batch=True, target is (B, d) and theta0 is (n,) or (B, n).
+    """
+    if not isinstance(arm, Chain):
+        raise ValueError(f"arm: expected a chain from ik.planar_chain or ik.serial_chain, "
+                         f"got {type(arm).__name__}")
+    n = arm.n_joints
+    if batch:
+        target = as_array(target, "targets", shape=(None, arm.dim))
+        per_target = np.ndim(theta0) == 2
+        theta0 = as_array(theta0, "theta0", shape=(target.shape[0], n) if per_target else (n,))
+    else:
+        target = as_array(target, "target", shape=(arm.dim,))
+        theta0 = as_array(theta0, "theta0", shape=(n,))
+    max_iter = as_count(max_iter, "max_iter", minimum=1)
+    if stall_tol is None:
+        stall_tol = STALL_FRACTION * float(reach(arm))
+    settings = Settings(
+        tol=as_number(tol, "tol", minimum=0, strict=True),
+        damping=as_number(damping, "damping", minimum=0),
+        rcond=as_number(rcond, "rcond", minimum=0),
+        clamp=np.inf if clamp is None else as_number(clamp, "clamp", minimum=0, strict=True),
+        max_step=np.inf if max_step is None else as_number(max_step, "max_step", minimum=0, strict=True),
+        stall_tol=as_number(stall_tol, "stall_tol", minimum=0),
+    )
+    return jnp.asarray(target), jnp.asarray(theta0), settings, max_iter
+
+
+def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DEFAULT_DAMPING,
+          rcond=DEFAULT_RCOND, clamp=None, max_step=None, stall_tol=None):
+    """Solve F(theta) = target from theta0 by repeated steps of `method`.
+
+    method    "jt", "pinv", "dls", or a function step(J, e) -> delta_theta.
+    tol       stop "converged" when ||e|| < tol.
+    max_iter  stop "max_iter" after this many steps.
+    damping   lambda of DLS.   rcond: the pseudoinverse's relative cut-off.
+    clamp     Buss's D_max: |e| is clamped to at most D_max before each step.
+    max_step  cap on any joint's change per step, in radians.
+    stall_tol stop "stalled" when sum |delta_theta_i| < stall_tol
+              (default STALL_FRACTION * total link length; 0 turns it off).
+    Returns a Result: theta, status, iterations, error (final ||e||) and trace.
+    """
+    step = resolve_method(method)
+    target, theta0, settings, max_iter = check_problem(
+        arm, target, theta0, tol=tol, max_iter=max_iter, damping=damping, rcond=rcond,
+        clamp=clamp, max_step=max_step, stall_tol=stall_tol)
+    n = arm.n_joints
+    if isinstance(step, UserStep) and not _traceable(step, arm.dim, n, settings):
+        state = _run_eager(step, arm, target, theta0, settings, max_iter, True)
+    else:
+        state = _run_jit(step, arm, target, theta0, settings, max_iter, True)
+    k = int(state.i)
+    trace = Trace(_frozen(state.trace_theta[: k + 1]), _frozen(state.trace_error[: k + 1]))
+    return Result(_frozen(state.theta), STATUSES[int(state.status)], k, float(state.error), trace)
+
+
+def _frozen(x):
+    arr = np.array(x, dtype=np.float64)
+    arr.flags.writeable = False
+    return arr
