@@ -26,9 +26,9 @@ class BatchResult:
         return {s: int(np.sum(self.status == s)) for s in STATUSES[1:]}
 
 
-@partial(jax.jit, static_argnames=("step", "max_iter"))
-def _run_batch(step, arm, targets, thetas0, settings, max_iter):
-    one = lambda t, q: run_loop(step, arm, t, q, settings, max_iter, False)
+@partial(jax.jit, static_argnames=("method", "task", "max_iter"))
+def _run_batch(method, task, arm, targets, thetas0, settings, max_iter):
+    one = lambda t, q: run_loop(method, task, arm, t, q, settings, max_iter, False)
     return jax.vmap(one)(targets, thetas0)
 
 
@@ -40,13 +40,13 @@ def solve_batch(arm, targets, theta0, method="dls", tol=1e-3, max_iter=1000,
     Same loop and stop rules as ik.solve (no trace is kept); method must be a name or a
     step function written with jax.numpy.
     """
-    step = resolve_method(method)
-    targets, theta0, settings, max_iter = check_problem(
+    method = resolve_method(method)
+    task, targets, theta0, settings, max_iter = check_problem(
         arm, targets, theta0, tol=tol, max_iter=max_iter, damping=damping, rcond=rcond,
         clamp=clamp, max_step=max_step, stall_tol=stall_tol, batch=True)
     if theta0.ndim == 1:
         theta0 = jnp.broadcast_to(theta0, (targets.shape[0], theta0.shape[0]))
-    state = _run_batch(step, arm, targets, theta0, settings, max_iter)
+    state = _run_batch(method, task, arm, targets, theta0, settings, max_iter)
     return BatchResult(
         theta=np.asarray(state.theta),
         status=np.asarray(STATUSES, dtype=object)[np.asarray(state.status)],

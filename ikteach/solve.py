@@ -18,13 +18,11 @@ import jax.numpy as jnp
 import numpy as np
 
 from ._validate import as_array, as_count, as_number
-from .chain import Chain, reach
 from .dls import dls_step
-from .jacobian import jacobian
 from .jt import jt_step
-from .kinematics import fk
 from .limits import cap_step, clamp_error
 from .pinv import DEFAULT_RCOND, pinv_step
+from .tasks import task_for
 
 STATUSES = ("running", "converged", "stalled", "max_iter", "diverged")
 RUNNING, CONVERGED, STALLED, MAX_ITER, DIVERGED = range(5)
@@ -55,7 +53,14 @@ def _dls(J, e, s):
     return dls_step(J, e, s.damping)
 
 
-METHODS = {"jt": _jt, "pinv": _pinv, "dls": _dls}
+@dataclasses.dataclass(frozen=True)
+class JacobianMethod:
+    """A method that turns (J, clamped e) into a step: step(J, e, settings) -> delta_theta."""
+    step: Callable
+
+    def delta(self, task, arm, target, theta, e, settings):
+        J = task.jacobian(arm, theta)
+        return self.step(J, clamp_error(e, settings.clamp), settings)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -65,6 +70,9 @@ class UserStep:
 
     def __call__(self, J, e, s):
         return self.fn(J, e)
+
+
+METHODS = {"jt": JacobianMethod(_jt), "pinv": JacobianMethod(_pinv), "dls": JacobianMethod(_dls)}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -101,22 +109,16 @@ class State(NamedTuple):
     trace_error: jax.Array
 
 
-def position_error(arm, target, theta):
-    """e = target - F(theta)."""
-    return target - fk(arm, theta)
-
-
-def _advance(step, arm, target, settings, max_iter, state):
+def _advance(method, task, arm, target, settings, max_iter, state):
     """One pass of the loop described in the module docstring."""
-    e = position_error(arm, target, state.theta)
+    e = task.error(arm, target, state.theta)
     err = jnp.linalg.norm(e)
     trace_error = state.trace_error.at[state.i].set(err) if state.trace_error.size else state.trace_error
     status = jnp.select(
         [~jnp.isfinite(err), err < settings.tol,
          (state.i > 0) & (state.last_step < settings.stall_tol), state.i >= max_iter],
         [DIVERGED, CONVERGED, STALLED, MAX_ITER], RUNNING)
-    J = jacobian(arm, state.theta)
-    delta = jnp.asarray(step(J, clamp_error(e, settings.clamp), settings))
+    delta = jnp.asarray(method.delta(task, arm, target, state.theta, e, settings))
     if delta.shape != state.theta.shape:
         raise ValueError(f"method: the step function returned shape {delta.shape}, "
                          f"expected {state.theta.shape} (one entry per joint)")
@@ -142,30 +144,29 @@ def _initial_state(theta0, max_iter, record):
                  jnp.asarray(RUNNING), trace_theta, jnp.zeros((rows,)))
 
 
-def run_loop(step, arm, target, theta0, settings, max_iter, record):
+def run_loop(method, task, arm, target, theta0, settings, max_iter, record):
     """The loop as a lax.while_loop (traceable: used under jit and vmap)."""
-    body = partial(_advance, step, arm, target, settings, max_iter)
+    body = partial(_advance, method, task, arm, target, settings, max_iter)
     return jax.lax.while_loop(lambda s: s.status == RUNNING, body,
                               _initial_state(theta0, max_iter, record))
 
 
-_run_jit = jax.jit(run_loop, static_argnames=("step", "max_iter", "record"))
+_run_jit = jax.jit(run_loop, static_argnames=("method", "task", "max_iter", "record"))
 
 
-def _run_eager(step, arm, target, theta0, settings, max_iter, record):
+def _run_eager(method, task, arm, target, theta0, settings, max_iter, record):
     """The same loop, one Python iteration at a time, for step functions JAX cannot trace."""
     state = _initial_state(theta0, max_iter, record)
     while int(state.status) == RUNNING:
-        state = _advance(step, arm, target, settings, max_iter, state)
+        state = _advance(method, task, arm, target, settings, max_iter, state)
     return state
 
 
-def _traceable(step, n_rows, n_joints, settings):
-    """Can JAX trace the step function (pure jax.numpy), or does it need eager execution?"""
-    J = jax.ShapeDtypeStruct((n_rows, n_joints), jnp.float64)
-    e = jax.ShapeDtypeStruct((n_rows,), jnp.float64)
+def traceable(method, task, arm, target, theta0, settings):
+    """Can JAX trace the method (pure jax.numpy), or does it need eager execution?"""
     try:
-        jax.eval_shape(lambda J, e: step(J, e, settings), J, e)
+        jax.eval_shape(lambda q: method.delta(task, arm, target, q, task.error(arm, target, q),
+                                              settings), theta0)
     except Exception:
         return False
     return True
@@ -185,31 +186,31 @@ def resolve_method(method):
             raise ValueError("method: a step function must accept two arguments (J, e)") from None
         except ValueError:
             pass  # builtins without a signature
-        return UserStep(method)
+        return JacobianMethod(UserStep(method))
     raise ValueError(f"method: expected one of {sorted(METHODS)} or a function "
                      f"step(J, e) -> delta_theta, got {method!r:.80}")
 
 
 def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, max_step,
                   stall_tol, batch=False):
-    """Validate everything solve/solve_batch take; returns (target, theta0, settings, max_iter).
+    """Validate everything solve/solve_batch take.
 
-    With batch=True, target is (B, d) and theta0 is (n,) or (B, n).
+    Returns (task, target, theta0, settings, max_iter). With batch=True, target holds
+    one target per row and theta0 is (n,) or (B, n).
     """
-    if not isinstance(arm, Chain):
-        raise ValueError(f"arm: expected a chain from ik.planar_chain or ik.serial_chain, "
-                         f"got {type(arm).__name__}")
+    name = "targets" if batch else "target"
+    target = as_array(target, name)
+    if batch and target.ndim < 2:
+        raise ValueError(f"targets: expected one target per row, got shape {target.shape}")
+    task = task_for(arm, target.shape[1:] if batch else target.shape, name)
     n = arm.n_joints
-    if batch:
-        target = as_array(target, "targets", shape=(None, arm.dim))
-        per_target = np.ndim(theta0) == 2
-        theta0 = as_array(theta0, "theta0", shape=(target.shape[0], n) if per_target else (n,))
+    if batch and np.ndim(theta0) == 2:
+        theta0 = as_array(theta0, "theta0", shape=(target.shape[0], n))
     else:
-        target = as_array(target, "target", shape=(arm.dim,))
         theta0 = as_array(theta0, "theta0", shape=(n,))
     max_iter = as_count(max_iter, "max_iter", minimum=1)
     if stall_tol is None:
-        stall_tol = STALL_FRACTION * float(reach(arm))
+        stall_tol = STALL_FRACTION * task.length_scale(arm)
     settings = Settings(
         tol=as_number(tol, "tol", minimum=0, strict=True),
         damping=as_number(damping, "damping", minimum=0),
@@ -218,7 +219,7 @@ def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, 
         max_step=np.inf if max_step is None else as_number(max_step, "max_step", minimum=0, strict=True),
         stall_tol=as_number(stall_tol, "stall_tol", minimum=0),
     )
-    return jnp.asarray(target), jnp.asarray(theta0), settings, max_iter
+    return task, jnp.asarray(target), jnp.asarray(theta0), settings, max_iter
 
 
 def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DEFAULT_DAMPING,
@@ -235,15 +236,12 @@ def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DE
               (default STALL_FRACTION * total link length; 0 turns it off).
     Returns a Result: theta, status, iterations, error (final ||e||) and trace.
     """
-    step = resolve_method(method)
-    target, theta0, settings, max_iter = check_problem(
+    method = resolve_method(method)
+    task, target, theta0, settings, max_iter = check_problem(
         arm, target, theta0, tol=tol, max_iter=max_iter, damping=damping, rcond=rcond,
         clamp=clamp, max_step=max_step, stall_tol=stall_tol)
-    n = arm.n_joints
-    if isinstance(step, UserStep) and not _traceable(step, arm.dim, n, settings):
-        state = _run_eager(step, arm, target, theta0, settings, max_iter, True)
-    else:
-        state = _run_jit(step, arm, target, theta0, settings, max_iter, True)
+    args = (method, task, arm, target, theta0, settings, max_iter, True)
+    state = (_run_jit if traceable(*args[:6]) else _run_eager)(*args)
     k = int(state.i)
     trace = Trace(_frozen(state.trace_theta[: k + 1]), _frozen(state.trace_error[: k + 1]))
     return Result(_frozen(state.theta), STATUSES[int(state.status)], k, float(state.error), trace)

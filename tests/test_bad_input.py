@@ -32,7 +32,7 @@ def test_bad_serial_chain(axes, offsets, message):
 
 
 @pytest.mark.parametrize("kwargs, message", [
-    (dict(target=[1.0]), r"target: expected shape \(2\)"),
+    (dict(target=[1.0]), r"target: expected shape \(2,\)"),
     (dict(target=[1.0, np.nan]), "target: expected finite"),
     (dict(theta0=[0.0, 0.0]), r"theta0: expected shape \(3\)"),
     (dict(theta0=[0.0, np.inf, 0.0]), "theta0: expected finite"),
@@ -48,6 +48,7 @@ def test_bad_serial_chain(axes, offsets, message):
     (dict(max_step=-1.0), "max_step: expected a number > 0"),
     (dict(stall_tol=-1.0), "stall_tol: expected a number >= 0"),
     (dict(arm="arm"), "arm: expected a chain"),
+    (dict(target=np.eye(4)), r"target: expected shape \(2,\)"),
 ])
 def test_bad_solver_input(kwargs, message):
     args = dict(arm=ARM, target=[1.0, 1.0], theta0=[0.0, 0.0, 0.0]) | kwargs
@@ -61,8 +62,8 @@ def test_step_function_with_the_wrong_output_shape():
 
 
 @pytest.mark.parametrize("targets, theta0, message", [
-    (np.ones(2), np.zeros(3), r"targets: expected shape \(any, 2\)"),
-    (np.ones((4, 3)), np.zeros(3), r"targets: expected shape \(any, 2\)"),
+    (np.ones(2), np.zeros(3), "targets: expected one target per row"),
+    (np.ones((4, 3)), np.zeros(3), r"targets: expected shape \(2,\)"),
     (np.ones((4, 2)), np.zeros((3, 3)), r"theta0: expected shape \(4, 3\)"),
 ])
 def test_bad_batch_input(targets, theta0, message):

@@ -1,0 +1,50 @@
+"""What a solve aims at: a task gives the error vector e(theta) and its Jacobian.
+
+The solve loop is the same for every task; a task only says how far the arm is from
+the target and how that distance changes with theta. Position targets on chains are
+built in; other tasks (pose targets, trees) add themselves to TASKS.
+"""
+import dataclasses
+
+from .chain import Chain, reach
+from .jacobian import jacobian
+from .kinematics import fk
+
+
+@dataclasses.dataclass(frozen=True)
+class PositionTask:
+    """Reach a point: e = target - F(theta), J the geometric Jacobian (d x n)."""
+
+    def accepts_arm(self, arm):
+        return isinstance(arm, Chain)
+
+    def accepts(self, arm, target_shape):
+        return self.accepts_arm(arm) and tuple(target_shape) == (arm.dim,)
+
+    def target_shape(self, arm):
+        return f"({arm.dim},)"
+
+    def error(self, arm, target, theta):
+        return target - fk(arm, theta)
+
+    def jacobian(self, arm, theta):
+        return jacobian(arm, theta)
+
+    def length_scale(self, arm):
+        return float(reach(arm))
+
+
+TASKS = [PositionTask()]
+
+
+def task_for(arm, target_shape, name="target"):
+    """The task that takes this arm and a target of this shape, or a ValueError naming `name`."""
+    tasks = [t for t in TASKS if t.accepts_arm(arm)]
+    if not tasks:
+        raise ValueError(f"arm: expected a chain from ik.planar_chain or ik.serial_chain, "
+                         f"got {type(arm).__name__}")
+    for task in tasks:
+        if task.accepts(arm, target_shape):
+            return task
+    wanted = " or ".join(t.target_shape(arm) for t in tasks)
+    raise ValueError(f"{name}: expected shape {wanted}, got shape {tuple(target_shape)}")
