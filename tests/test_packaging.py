@@ -29,7 +29,7 @@ def environment_runtime():
             names.add(_name(line[4:]))
         elif in_deps and line and not line.startswith(" "):
             in_deps = False
-    return names - {"python", "pip"}
+    return names - {"python", "pip", "pip:"}
 
 
 def test_environment_yml_matches_pyproject():
