@@ -15,6 +15,7 @@ from .dls import dls_step, dls_step_normal  # noqa: E402
 from .limits import clamp_error, cap_step  # noqa: E402
 from .solve import solve, Result, Trace, STATUSES, METHODS  # noqa: E402
 from .batch import solve_batch, BatchResult  # noqa: E402
+from . import notebook  # noqa: E402
 
 __all__ = [
     "Chain", "planar_chain", "serial_chain", "reach",
@@ -23,6 +24,6 @@ __all__ = [
     "jt_step", "optimal_alpha", "pinv_step", "dls_step", "dls_step_normal",
     "clamp_error", "cap_step",
     "solve", "Result", "Trace", "STATUSES", "METHODS",
-    "solve_batch", "BatchResult",
+    "solve_batch", "BatchResult", "notebook",
 ]
 __version__ = "0.1.0"

@@ -1,0 +1,47 @@
+"""One call at the top of every notebook: print precision, seeds, plotting defaults."""
+import os
+import random
+
+import numpy as np
+
+SEED = 0
+
+
+def setup(seed=SEED):
+    """Round printed numbers, seed the random generators, set plotting defaults.
+
+    Returns a numpy Generator seeded with `seed` for the notebook's own random draws.
+    Under test (no display, or PYVISTA_OFF_SCREEN set) pyvista renders off screen.
+    """
+    np.set_printoptions(precision=4, suppress=True, floatmode="fixed", linewidth=100)
+    random.seed(seed)
+    np.random.seed(seed)
+    import matplotlib as mpl
+
+    mpl.rcParams.update({
+        "figure.figsize": (6.4, 4.0),
+        "figure.dpi": 80,
+        "savefig.dpi": 80,
+        "axes.grid": True,
+        "grid.alpha": 0.3,
+        "animation.html": "jshtml",
+        "animation.embed_limit": 4.0,  # MB
+        "svg.hashsalt": "ikteach",
+    })
+    _setup_pyvista()
+    return np.random.default_rng(seed)
+
+
+def _setup_pyvista():
+    try:
+        import pyvista as pv
+    except ImportError:
+        return
+    headless = not os.environ.get("DISPLAY") or os.environ.get("PYVISTA_OFF_SCREEN")
+    if headless:
+        pv.OFF_SCREEN = True
+    try:
+        import trame  # noqa: F401  (live 3-D in Jupyter when available)
+        pv.set_jupyter_backend("static" if headless else "trame")
+    except ImportError:
+        pv.set_jupyter_backend("static")
