@@ -86,8 +86,9 @@ def _student_line(exc):
     return ""
 
 
-def _call(fn, name, case, *args, limit=TIME_LIMIT):
+def _call(fn, name, case, *args, limit=None):
     """fn(*args) under a time limit; student errors become _NotYet/_Fail/_Abort."""
+    limit = TIME_LIMIT if limit is None else limit
     try:
         with _time_limit(limit), np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)  # NaN is reported by the check
@@ -143,8 +144,10 @@ def _close(a, b, rtol=1e-6, atol=1e-9):
 
 
 def _mismatch(got, want, case, what="the step"):
-    return (f"\n  smallest failing case: {case}\n  expected {what}: {_fmt(want)}"
-            f"\n  your result:       {_fmt(got)}")
+    label = f"expected {what}:"
+    width = max(len(label), len("your result:"))
+    return (f"\n  smallest failing case: {case}\n  {label:<{width}} {_fmt(want)}"
+            f"\n  {'your result:':<{width}} {_fmt(got)}")
 
 
 def _shape_message(name, got, want, case, hint=""):
@@ -502,9 +505,17 @@ def _pinv_parts(fn, name):
 
     def run(tag):
         def check():
+            results = {}
             for case in (c for c in cases if c.tag == tag):
                 J, e, rcond = case.args
-                got = _as_array(_call(fn, name, case, J.copy(), e.copy(), rcond), name, case)
+                results[id(case)] = _as_array(_call(fn, name, case, J.copy(), e.copy(), rcond),
+                                              name, case)
+            absolute = all(_close(results[id(c)], _pinv_variant(*c.args[:2], lambda s, r=c.args[2]:
+                                                                 s >= r))
+                           for c in cases if c.tag == tag)
+            for case in (c for c in cases if c.tag == tag):
+                J, e, rcond = case.args
+                got = results[id(case)]
                 want = np.asarray(_ref_pinv(J, e, rcond))
                 if got.shape != want.shape:
                     hint = (" - one entry per joint: delta_theta = V Sigma^+ U^T e"
@@ -518,6 +529,10 @@ def _pinv_parts(fn, name):
                             + _mismatch(got, want, case))
                 if _close(got, -want):
                     return "wrong sign: delta_theta = +J^+ e." + _mismatch(got, want, case)
+                if absolute and tag == "cutoff":
+                    return ("the cut-off must be relative: drop sigma_i < rcond * sigma_max "
+                            "(the largest singular value), not sigma_i < rcond."
+                            + _mismatch(got, want, case))
                 if _close(got, _pinv_variant(J, e, lambda s: s > 0), rtol=1e-4):
                     return ("no cut-off: 1/sigma_i must be dropped for sigma_i < rcond * "
                             f"sigma_max; here your step is {np.linalg.norm(got):.3g} long."

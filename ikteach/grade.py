@@ -18,6 +18,7 @@ its own marks; the grader finishes and says what happened in the feedback.
 import argparse
 import csv
 import json
+import logging
 import re
 import secrets
 import shutil
@@ -74,6 +75,7 @@ def grade_notebook(path, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT):
     from nbclient import NotebookClient
     from nbclient.exceptions import CellTimeoutError, DeadKernelError
 
+    logging.getLogger("asyncio").setLevel(logging.CRITICAL)  # nbclient noise after a timeout
     path = Path(path)
     result = {"file": path.name, "exercise": None, "score": 0.0, "max": float(POINTS),
               "status": "not graded", "message": "", "notes": []}
