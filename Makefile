@@ -4,7 +4,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed-stamp
 
-.PHONY: lab test bench clean
+.PHONY: lab test bench clean exercises
 
 $(STAMP): pyproject.toml
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -19,7 +19,13 @@ lab: $(STAMP)
 	$(VENV)/bin/jupyter lab --notebook-dir=notebooks $(LAB_ARGS)
 
 test: $(STAMP)
-	$(PY) -m pytest -n 2 tests $(wildcard notebooks/*.ipynb) --nbval --nbval-sanitize-with tests/nbval_sanitize.cfg
+	$(PY) -m pytest -n 2 --dist loadfile tests $(wildcard notebooks/*.ipynb) $(EXERCISES) --nbval --nbval-sanitize-with tests/nbval_sanitize.cfg
+
+# Exercise templates (check cells print "not yet implemented") and the instructor's solutions.
+EXERCISES = $(wildcard notebooks/exercises/*.ipynb) $(wildcard instructor/solutions/*.ipynb)
+
+exercises: $(STAMP)
+	$(PY) -m ikteach.exercises build
 
 clean:
 	rm -rf $(VENV) .pytest_cache .hypothesis

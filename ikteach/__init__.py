@@ -14,8 +14,10 @@ from .pinv import pinv_step  # noqa: E402
 from .dls import dls_step, dls_step_normal  # noqa: E402
 from .limits import clamp_error, cap_step  # noqa: E402
 from .solve import solve, Result, Trace, STATUSES, METHODS  # noqa: E402
+from .solve import StopSolve  # noqa: E402
 from .batch import solve_batch, BatchResult  # noqa: E402
 from . import notebook  # noqa: E402
+from . import check  # noqa: E402
 
 __all__ = [
     "Chain", "planar_chain", "serial_chain", "reach",
@@ -25,5 +27,6 @@ __all__ = [
     "clamp_error", "cap_step",
     "solve", "Result", "Trace", "STATUSES", "METHODS",
     "solve_batch", "BatchResult", "notebook",
+    "StopSolve", "check",
 ]
 __version__ = "0.1.0"

@@ -28,6 +28,13 @@ STATUSES = ("running", "converged", "stalled", "max_iter", "diverged")
 RUNNING, CONVERGED, STALLED, MAX_ITER, DIVERGED = range(5)
 
 DEFAULT_DAMPING = 0.5
+
+
+class StopSolve(Exception):
+    """Raise from a step function to end the solve "stalled" (e.g. an out-of-reach stop rule).
+
+    The loop keeps the current theta; the step that raised is not taken.
+    """
 STALL_FRACTION = 1e-5  # default stall_tol = STALL_FRACTION * total link length
 
 
@@ -158,7 +165,13 @@ def _run_eager(method, task, arm, target, theta0, settings, max_iter, record):
     """The same loop, one Python iteration at a time, for step functions JAX cannot trace."""
     state = _initial_state(theta0, max_iter, record)
     while int(state.status) == RUNNING:
-        state = _advance(method, task, arm, target, settings, max_iter, state)
+        try:
+            state = _advance(method, task, arm, target, settings, max_iter, state)
+        except StopSolve:  # the step function's own stop rule fired
+            err = jnp.linalg.norm(task.error(arm, target, state.theta))
+            trace_error = state.trace_error.at[state.i].set(err) if record else state.trace_error
+            status = CONVERGED if err < settings.tol else STALLED  # same order as _advance
+            state = state._replace(error=err, status=jnp.asarray(status), trace_error=trace_error)
     return state
 
 
@@ -226,7 +239,8 @@ def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DE
           rcond=DEFAULT_RCOND, clamp=None, max_step=None, stall_tol=None):
     """Solve F(theta) = target from theta0 by repeated steps of `method`.
 
-    method    "jt", "pinv", "dls", or a function step(J, e) -> delta_theta.
+    method    "jt", "pinv", "dls", or a function step(J, e) -> delta_theta
+              (it may raise ik.StopSolve to end the solve "stalled": its own stop rule).
     tol       stop "converged" when ||e|| < tol.
     max_iter  stop "max_iter" after this many steps.
     damping   lambda of DLS.   rcond: the pseudoinverse's relative cut-off.

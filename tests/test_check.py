@@ -1,0 +1,193 @@
+"""ik.check: the verdicts on right and wrong student functions (no kernels: direct calls)."""
+import numpy as np
+import pytest
+
+import ikteach as ik
+from ikteach import check
+
+
+def planar_jacobian(lengths, theta):
+    p = np.asarray(ik.joint_positions(ik.planar_chain(lengths), theta))
+    d = p[-1] - p[:-1]
+    return np.stack([-d[:, 1], d[:, 0]])
+
+
+def jt_step(J, e):
+    g = J.T @ e
+    v = J @ g
+    return np.zeros(J.shape[1]) if v @ v == 0 else (e @ v / (v @ v)) * g
+
+
+def pinv_no_cutoff(J, e, rcond):
+    U, s, Vt = np.linalg.svd(J, full_matrices=False)
+    keep = s > 0
+    inv = np.zeros_like(s)
+    inv[keep] = 1 / s[keep]
+    return Vt.T @ (inv * (U.T @ e))
+
+
+def stalled(delta_theta, lengths, fraction):
+    return bool(np.sum(np.abs(delta_theta)) < fraction * np.sum(lengths))
+
+
+def stop_rule_step(step, lengths, fraction):
+    def wrapped(J, e):
+        delta = np.asarray(step(J, e))
+        if stalled(delta, lengths, fraction):
+            raise ik.StopSolve()
+        return delta
+    return wrapped
+
+
+def not_yet(*args):
+    raise NotImplementedError
+
+
+def test_correct_functions_pass():
+    assert check.jacobian_verdict(planar_jacobian).score == 10
+    assert check.jt_step_verdict(jt_step).passed
+    assert check.pinv_step_verdict(lambda J, e, r: np.asarray(ik.pinv_step(J, e, r))).passed
+    assert check.dls_step_verdict(ik.dls_step, ik.dls_step_normal).passed
+
+
+@pytest.mark.parametrize("wrong, score, words", [
+    (lambda L, t: -planar_jacobian(L, t), 2, "wrong sign"),
+    (lambda L, t: planar_jacobian(L, t).T, 0, "transposed"),
+    (lambda L, t: planar_jacobian(L, t)[:, ::-1], 2, "reverse order"),
+    (lambda L, t: None, 0, "forget `return`"),
+    (lambda L, t: "J", 0, "expected an array of numbers"),
+    (lambda L, t: 1 / 0, 0, "raised ZeroDivisionError"),
+])
+def test_jacobian_mistakes(wrong, score, words):
+    verdict = check.jacobian_verdict(wrong)
+    assert verdict.score == score and verdict.status == "failed"
+    assert words in verdict.message
+
+
+def test_the_smallest_failing_case_is_shown():
+    message = check.jacobian_verdict(lambda L, t: -planar_jacobian(L, t)).message
+    assert "smallest failing case: lengths = [1.], theta = [0.]" in message
+    message = check.jacobian_verdict(lambda L, t: planar_jacobian(L, t)[:, ::-1]).message
+    assert "smallest failing case: lengths = [1., 2.]" in message  # 1 joint cannot show it
+
+
+@pytest.mark.parametrize("wrong, score, words", [
+    (lambda J, e: 0.1 * (J.T @ e), 6, "alpha looks fixed: it is 0.1"),
+    (lambda J, e: 2 * jt_step(J, e), 6, "off by a factor of 2"),
+    (lambda J, e: -jt_step(J, e), 2, "wrong sign"),
+])
+def test_jt_mistakes(wrong, score, words):
+    verdict = check.jt_step_verdict(wrong)
+    assert (verdict.score, verdict.status) == (score, "failed")
+    assert words in verdict.message
+
+
+def test_jt_nan_at_zero_error_is_named():
+    def naive(J, e):
+        g = J.T @ e
+        v = J @ g
+        return (e @ v / (v @ v)) * g
+    verdict = check.jt_step_verdict(naive)
+    assert verdict.score == 8 and "NaN where J J^T e = 0" in verdict.message
+
+
+def test_pinv_without_cutoff():
+    verdict = check.pinv_step_verdict(pinv_no_cutoff)
+    assert verdict.score == 5 and "no cut-off" in verdict.message
+    plain = check.pinv_step_verdict(
+        lambda J, e, r: np.linalg.svd(J, full_matrices=False)[2].T
+        @ ((np.linalg.svd(J, full_matrices=False)[0].T @ e) / np.linalg.svd(J, compute_uv=False)))
+    assert plain.score == 5 and "NaN or inf at a singular J" in plain.message
+
+
+def test_pinv_absolute_cutoff():
+    def absolute(J, e, rcond):
+        U, s, Vt = np.linalg.svd(J, full_matrices=False)
+        inv = np.where(s >= rcond, 1 / np.where(s >= rcond, s, 1), 0)
+        return Vt.T @ (inv * (U.T @ e))
+    verdict = check.pinv_step_verdict(absolute)
+    assert verdict.score == 5 and "must be relative" in verdict.message
+
+
+def test_dls_lambda_not_squared_and_partial_credit():
+    lam = lambda J, e, l: J.T @ np.linalg.solve(J @ J.T + l * np.eye(J.shape[0]), e)
+    verdict = check.dls_step_verdict(lam, ik.dls_step_normal)
+    assert verdict.score == 4 and "missing square on lambda" in verdict.message
+    assert "your two forms disagree" not in verdict.message  # the first failure is shown
+    assert verdict.parts == {"dls_step": False, "dls_step_normal": True, "agree": False}
+
+
+def test_not_implemented_is_not_an_error(capsys):
+    check.jacobian(not_yet)
+    out = capsys.readouterr().out
+    assert "not yet implemented" in out and "Traceback" not in out
+    assert check.dls_step_verdict(not_yet, not_yet).status == "not implemented"
+    half = check.dls_step_verdict(ik.dls_step, not_yet)
+    assert half.status == "failed" and half.score == 4
+    assert check.singularity_study_verdict(not_yet).status == "not implemented"
+
+
+def test_endless_loop_is_stopped(monkeypatch):
+    monkeypatch.setattr(check, "TIME_LIMIT", 0.3)
+
+    def forever(J, e):
+        while True:
+            try:
+                pass
+            except Exception:  # student code that swallows errors does not swallow the limit
+                pass
+    verdict = check.jt_step_verdict(forever)
+    assert verdict.score == 0 and "did not return within 0.3 s" in verdict.message
+
+
+def test_messages_show_the_students_line_not_ikteach_internals():
+    def broken(J, e):
+        return J @ e  # wrong product
+    message = check.jt_step_verdict(broken).message
+    assert "raised ValueError" in message and "J @ e  # wrong product" in message
+    assert "ikteach/" not in message and "Traceback" not in message
+
+
+def test_stop_rule():
+    assert check.stop_rule_verdict(stalled, stop_rule_step).passed
+    signed = check.stop_rule_verdict(lambda d, L, f: np.sum(d) < f * np.sum(L), stop_rule_step)
+    assert signed.score == 5 and "absolute values" in signed.message
+    unscaled = check.stop_rule_verdict(lambda d, L, f: np.abs(d).sum() < f, stop_rule_step)
+    assert "proportional to the link lengths" in unscaled.message
+    never_stops = check.stop_rule_verdict(stalled, lambda step, L, f: step)
+    assert never_stops.score == 5 and "raise ik.StopSolve" in never_stops.message
+
+
+def test_singularity_study_answers_checked_by_value():
+    reference = check._reference_study()
+    assert reference["blows_up"] == ["pinv"]
+    right = check.singularity_study_verdict(lambda jt, pinv, dls: dict(reference))
+    assert right.passed
+    wrong = dict(reference, smallest_lambda=0.2, fewest_iterations="jt")
+    verdict = check.singularity_study_verdict(lambda jt, pinv, dls: wrong)
+    assert verdict.score == 5
+    assert "'fewest_iterations' is not right" in verdict.message
+    assert verdict.parts["smallest_lambda"] is False
+    assert "must return a dict" in check.singularity_study_verdict(lambda *a: 3).message
+
+
+def test_grade_finds_functions_in_a_namespace():
+    assert check.grade(2, {"jt_step": jt_step}).passed
+    missing = check.grade(2, {})
+    assert missing.score == 0 and "`jt_step` not found" in missing.message
+    with pytest.raises(ValueError, match="number"):
+        check.grade(7, {})
+
+
+def test_stop_solve_hook_ends_the_solve_stalled():
+    arm = ik.planar_chain([1.0, 1.0, 1.0])
+    theta0 = np.array([0.3, 0.2, 0.1])
+    step = stop_rule_step(lambda J, e: ik.dls_step(J, e, 1.0), [1, 1, 1], 1e-3)
+    res = ik.solve(arm, np.array([4.0, 0.5]), theta0, method=step, stall_tol=0, max_iter=300)
+    assert res.status == "stalled" and 0 < res.iterations < 300
+    assert len(res.trace.error) == res.iterations + 1 and np.isfinite(res.error)
+    assert res.error == pytest.approx(np.linalg.norm([4.0, 0.5] - np.asarray(ik.fk(arm, res.theta))))
+    # the stop rule never overrides convergence (checked first, as in the built-in loop):
+    # at the target the step is 0, the rule fires, and the solve still ends "converged"
+    res = ik.solve(arm, np.asarray(ik.fk(arm, theta0)), theta0, method=step, stall_tol=0)
+    assert (res.status, res.iterations) == ("converged", 0)
