@@ -56,8 +56,17 @@ class Demo:
         self.widget = w.VBox([w.HBox([w.VBox([self.x, self.y]),
                                       w.VBox([self.damping, self.method])]),
                               self.preset, self.text, self.image])
-        self._fig = Figure(figsize=(4.2, 4.2), dpi=80)
-        self._ax = self._fig.add_subplot()
+        self._fig = Figure(figsize=(3.8, 3.8), dpi=80)
+        self._ax = ax = self._fig.add_axes((0.02, 0.02, 0.96, 0.9))
+        plot.arm_axes(ax, self.arm, margin=1.3)
+        ax.set_xticks([])
+        ax.set_yticks([])
+        plot.draw_reach(ax, self.arm)
+        plot.draw_arm(ax, self.arm, self.theta0, color="0.7", lw=2, joints=False)
+        (self._path,) = ax.plot([], [], ".-", color="C1", lw=1, ms=3, alpha=0.7)
+        self._arm = plot.draw_arm(ax, self.arm, self.theta0)
+        self._target = plot.draw_target(ax, target)
+        self._title = ax.set_title("", fontsize=8)
         self._holding = False
         for control in (self.x, self.y, self.damping, self.method):
             control.observe(self._changed, names="value")
@@ -95,15 +104,17 @@ class Demo:
         return self.result
 
     def _draw(self, target):
-        ax, res = self._ax, self.result
-        ax.clear()
-        plot.arm_axes(ax, self.arm, margin=1.3)
-        plot.draw_reach(ax, self.arm)
-        plot.draw_arm(ax, self.arm, self.theta0, color="0.7", lw=2, joints=False)
-        plot.draw_path(ax, self.arm, res.trace.theta, color="C1")
-        plot.draw_arm(ax, self.arm, res.theta, color=plot.color_for(self.method.value))
-        plot.draw_target(ax, target)
-        ax.set_title(self.summary, fontsize=8)
+        """Move the persistent artists (cheaper than redrawing the axes) and render a PNG."""
+        res = self.result
+        path = plot.end_path(self.arm, res.trace.theta)
+        self._path.set_data(path[:, 0], path[:, 1])
+        plot.set_arm(self._arm, self.arm, res.theta)
+        color = plot.color_for(self.method.value)
+        for artist in self._arm:
+            artist.set_color(color)
+        self._arm[1].set_markerfacecolor("white")
+        self._target.set_data([target[0]], [target[1]])
+        self._title.set_text(self.summary)
         buf = io.BytesIO()
         self._fig.savefig(buf, format="png")
         return buf.getvalue()

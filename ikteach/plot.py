@@ -30,7 +30,7 @@ from .jacobian import jacobian
 from .kinematics import joint_positions
 
 METHOD_COLORS = {"jt": "C0", "pinv": "C3", "dls": "C2"}
-MAX_FRAMES = 20
+MAX_FRAMES = 16
 TRAIL = 30  # end-effector positions kept behind each arm in a race
 
 
