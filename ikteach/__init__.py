@@ -30,3 +30,6 @@ __all__ = [
     "StopSolve", "check",
 ]
 __version__ = "0.1.0"
+from . import plot  # noqa: E402
+from . import demo  # noqa: E402
+__all__ += ["plot", "demo"]

@@ -1,0 +1,90 @@
+"""Plot helpers: figures render, animations have the expected frames, still frames are PNGs."""
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+import ikteach as ik  # noqa: E402
+from ikteach import plot  # noqa: E402
+
+ARM = ik.planar_chain([1.0, 1.0, 1.0])
+START = np.array([0.1, 0.2, 0.3])
+PNG = b"\x89PNG"
+
+
+def test_draw_arm_puts_the_joints_where_fk_says():
+    fig, ax = plt.subplots()
+    theta = np.array([0.3, -0.5, 0.9])
+    links, joints, end = plot.draw_arm(ax, ARM, theta)
+    xy = np.column_stack(links.get_data())
+    np.testing.assert_allclose(xy, np.asarray(ik.joint_positions(ARM, theta)))
+    np.testing.assert_allclose(np.column_stack(end.get_data())[0], np.asarray(ik.fk(ARM, theta)))
+    plot.set_arm((links, joints, end), ARM, np.zeros(3))
+    np.testing.assert_allclose(np.column_stack(end.get_data())[0], [3.0, 0.0])
+    plt.close(fig)
+
+
+def test_velocity_ellipse_has_the_singular_values_as_semi_axes():
+    theta = np.array([0.4, 0.8, -0.3])
+    J = np.asarray(ik.jacobian(ARM, theta))
+    pts = plot.velocity_ellipse(J, n_points=2001)
+    radii = np.linalg.norm(pts, axis=0)
+    s = np.linalg.svd(J, compute_uv=False)
+    assert radii.max() == pytest.approx(s[0], rel=1e-5)
+    assert radii.min() == pytest.approx(s[1], rel=1e-5)
+
+
+def test_velocity_ellipse_collapses_to_a_segment_at_a_singular_pose():
+    pts = plot.velocity_ellipse(ik.jacobian(ARM, np.zeros(3)))
+    # straight arm along x: the end effector can only move along y
+    assert np.abs(pts[0]).max() < 1e-12 and np.abs(pts[1]).max() > 1.0
+
+
+def test_frame_iterations_keep_first_and_last_and_the_limit():
+    for k in (0, 3, 23, 24, 150, 1000):
+        for spacing in ("linear", "log"):
+            ks = plot.frame_iterations(k, 24, spacing)
+            assert ks[0] == 0 and ks[-1] == k
+            assert len(ks) == min(k + 1, 24)
+            assert np.all(np.diff(ks) > 0)
+
+
+def test_animate_solve_has_one_frame_per_shown_iteration_and_ends_at_the_solution():
+    res = ik.solve(ARM, [2.5, 0.5], START, method="jt")
+    anim = plot.animate_solve(ARM, res, [2.5, 0.5], max_frames=12)
+    assert len(anim.iterations) == 12 and anim.iterations[-1] == res.iterations
+    assert anim._save_count == 12 or len(list(anim.new_frame_seq())) == 12
+    png = plot.still_png(anim)
+    assert png.startswith(PNG)
+    arm_ax = anim._fig.axes[0]
+    tip = np.asarray(ik.fk(ARM, res.theta))
+    ends = [l for l in arm_ax.lines if l.get_marker() == "s"]
+    np.testing.assert_allclose(np.column_stack(ends[-1].get_data())[0], tip)
+    assert "converged" in arm_ax.get_title()
+
+
+def test_animate_race_draws_every_method_and_embeds_under_the_limit():
+    results = {m: ik.solve(ARM, [3.5, 1.0], START, method=m, max_iter=200) for m in ("jt", "pinv", "dls")}
+    anim = plot.animate_race(ARM, results, [3.5, 1.0], max_frames=10)
+    assert len(anim._fig.axes) == 4
+    assert list(anim.iterations) == list(plot.frame_iterations(200, 10, "log"))
+    plot.still_png(anim)
+    titles = [ax.get_title() for ax in anim._fig.axes[:3]]
+    for name, title in zip(results, titles):
+        assert title.startswith(name) and results[name].status in title
+    html = anim.to_jshtml()
+    assert html.count("data:image/png;base64") == 10
+    assert len(html.encode()) < 4 * 2**20
+
+
+def test_plot_errors_draws_one_curve_per_result():
+    fig, ax = plt.subplots()
+    results = {m: ik.solve(ARM, [2.5, 0.5], START, method=m) for m in ("pinv", "dls")}
+    lines = plot.plot_errors(ax, results, tol=1e-3)
+    assert [l.get_label() for l in lines] == ["pinv", "dls"]
+    for line, res in zip(lines, results.values()):
+        np.testing.assert_allclose(line.get_ydata(), res.trace.error)
+    plt.close(fig)
