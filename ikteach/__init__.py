@@ -16,6 +16,12 @@ from .limits import clamp_error, cap_step  # noqa: E402
 from .solve import solve, Result, Trace, STATUSES, METHODS  # noqa: E402
 from .batch import solve_batch, BatchResult  # noqa: E402
 from . import notebook  # noqa: E402
+from .sdls import sdls_step, GAMMA_MAX  # noqa: E402
+from .ccd import ccd_sweep, ccd_angle  # noqa: E402
+from .fabrik import fabrik_pass  # noqa: E402
+from .tree import Tree, tree, tree_fk, tree_frames, tree_jacobian, tree_jacobian_autodiff  # noqa: E402
+from .track import track, TrackResult  # noqa: E402
+from . import buss_trees  # noqa: E402
 
 __all__ = [
     "Chain", "planar_chain", "serial_chain", "reach",
@@ -25,5 +31,8 @@ __all__ = [
     "clamp_error", "cap_step",
     "solve", "Result", "Trace", "STATUSES", "METHODS",
     "solve_batch", "BatchResult", "notebook",
+    "sdls_step", "GAMMA_MAX", "ccd_sweep", "ccd_angle", "fabrik_pass",
+    "Tree", "tree", "tree_fk", "tree_frames", "tree_jacobian", "tree_jacobian_autodiff",
+    "track", "TrackResult", "buss_trees",
 ]
 __version__ = "0.1.0"
