@@ -53,6 +53,7 @@ def fabrik_stretch(points, lengths, target):
 
 def fabrik_pass(points, lengths, target):
     """One FABRIK iteration on the points (stretch when the target is out of reach)."""
+    points, lengths, target = jnp.asarray(points), jnp.asarray(lengths), jnp.asarray(target)
     reachable = jnp.linalg.norm(target - points[0]) <= jnp.sum(lengths)
     inside = fabrik_backward(fabrik_forward(points, lengths, target), lengths, points[0])
     return jnp.where(reachable, inside, fabrik_stretch(points, lengths, target))

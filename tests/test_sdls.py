@@ -30,11 +30,11 @@ def test_small_errors_give_the_pseudoinverse_step(case):
 
 
 def test_singular_direction_is_damped_not_blown_up():
-    # straight arm, target straight ahead past the tip's reach: J has a tiny sigma along x
-    theta = np.array([1e-4, 0.0, 0.0])
+    # nearly straight arm, target straight ahead: J has a small sigma (about 0.012) along x
+    theta = np.array([0.0, 0.02, 0.0])
     J = np.asarray(ik.jacobian(ARM, theta))
     e = np.array([0.5, 0.0])
-    assert np.max(np.abs(ik.pinv_step(J, e))) > 100
+    assert np.max(np.abs(ik.pinv_step(J, e))) > 10
     assert np.max(np.abs(ik.sdls_step(J, e))) <= ik.GAMMA_MAX
 
 

@@ -110,8 +110,10 @@ def test_tracking_follows_the_y_targets():
     res = ik.track(Y, targets, method="sdls", clamp=buss_trees.D_MAX)
     assert res.theta.shape == (301, 7) and res.error.shape == (300,)
     assert np.all(np.isfinite(res.theta))
-    # the error is large at the start (rest pose) and falls as the tree catches up
-    assert res.error[-100:].mean() < 0.25 * res.error[:5].mean()
+    # target 0 is at times out of reach, so the error never reaches 0; but following the
+    # targets must do far better than standing still in the rest pose
+    still = np.linalg.norm(targets - np.asarray(ik.tree_fk(Y, np.zeros(7))), axis=2).sum(axis=1)
+    assert res.error.mean() < 0.4 * still.mean()
 
 
 def test_bad_tree_input_names_the_parameter():
