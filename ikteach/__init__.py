@@ -21,7 +21,7 @@ from .ccd import ccd_sweep, ccd_angle  # noqa: E402
 from .fabrik import fabrik_pass  # noqa: E402
 from .tree import Tree, tree, tree_fk, tree_frames, tree_jacobian, tree_jacobian_autodiff  # noqa: E402
 from .track import track, TrackResult  # noqa: E402
-from . import buss_trees  # noqa: E402
+from . import buss_trees, tree_plot  # noqa: E402
 
 __all__ = [
     "Chain", "planar_chain", "serial_chain", "reach",
@@ -33,6 +33,6 @@ __all__ = [
     "solve_batch", "BatchResult", "notebook",
     "sdls_step", "GAMMA_MAX", "ccd_sweep", "ccd_angle", "fabrik_pass",
     "Tree", "tree", "tree_fk", "tree_frames", "tree_jacobian", "tree_jacobian_autodiff",
-    "track", "TrackResult", "buss_trees",
+    "track", "TrackResult", "buss_trees", "tree_plot",
 ]
 __version__ = "0.1.0"
