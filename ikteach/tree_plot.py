@@ -19,9 +19,8 @@ def draw_tree(ax, arm, theta, targets=None, plane=(0, 1), color="C0"):
     lines = [ax.plot(s[:, i], s[:, j], "-", color=color, lw=3, solid_capstyle="round")[0] for s in segs]
     joints = ax.plot(p[:, i], p[:, j], "o", color="k", ms=4)[0]
     effs = ax.plot(x[:, i], x[:, j], "s", color=color, ms=6)[0]
-    tgt = ax.plot([], [], "x", color="C3", ms=9, mew=2)[0]
-    if targets is not None:
-        tgt.set_data(np.asarray(targets)[:, i], np.asarray(targets)[:, j])
+    t = np.empty((0, 3)) if targets is None else np.asarray(targets)
+    tgt = ax.plot(t[:, i], t[:, j], "x", color="C3", ms=9, mew=2)[0]
     ax.set_aspect("equal")
     ax.set_xlabel("xyz"[i])
     ax.set_ylabel("xyz"[j])
