@@ -18,6 +18,13 @@ from .solve import StopSolve  # noqa: E402
 from .batch import solve_batch, BatchResult  # noqa: E402
 from . import notebook  # noqa: E402
 from . import check  # noqa: E402
+from .sdls import sdls_step, GAMMA_MAX  # noqa: E402
+from .ccd import ccd_sweep, ccd_angle  # noqa: E402
+from .fabrik import fabrik_pass  # noqa: E402
+from .tree import Tree, tree, tree_fk, tree_frames, tree_jacobian, tree_jacobian_autodiff  # noqa: E402
+from .track import track, TrackResult  # noqa: E402
+from . import buss_trees, tree_plot  # noqa: E402
+from . import plot, demo  # noqa: E402
 
 __all__ = [
     "Chain", "planar_chain", "serial_chain", "reach",
@@ -28,8 +35,8 @@ __all__ = [
     "solve", "Result", "Trace", "STATUSES", "METHODS",
     "solve_batch", "BatchResult", "notebook",
     "StopSolve", "check",
+    "sdls_step", "GAMMA_MAX", "ccd_sweep", "ccd_angle", "fabrik_pass",
+    "Tree", "tree", "tree_fk", "tree_frames", "tree_jacobian", "tree_jacobian_autodiff",
+    "track", "TrackResult", "buss_trees", "tree_plot", "plot", "demo",
 ]
 __version__ = "0.1.0"
-from . import plot  # noqa: E402
-from . import demo  # noqa: E402
-__all__ += ["plot", "demo"]

@@ -7,6 +7,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .pinv import DEFAULT_RCOND
+from .sdls import GAMMA_MAX
 from .solve import DEFAULT_DAMPING, STATUSES, check_problem, resolve_method, run_loop
 
 
@@ -34,7 +35,7 @@ def _run_batch(method, task, arm, targets, thetas0, settings, max_iter):
 
 def solve_batch(arm, targets, theta0, method="dls", tol=1e-3, max_iter=1000,
                 damping=DEFAULT_DAMPING, rcond=DEFAULT_RCOND, clamp=None, max_step=None,
-                stall_tol=None):
+                stall_tol=None, gamma_max=GAMMA_MAX):
     """Solve for every row of targets (B, d); theta0 is one start (n,) or one per target (B, n).
 
     Same loop and stop rules as ik.solve (no trace is kept); method must be a name or a
@@ -43,7 +44,7 @@ def solve_batch(arm, targets, theta0, method="dls", tol=1e-3, max_iter=1000,
     method = resolve_method(method)
     task, targets, theta0, settings, max_iter = check_problem(
         arm, targets, theta0, tol=tol, max_iter=max_iter, damping=damping, rcond=rcond,
-        clamp=clamp, max_step=max_step, stall_tol=stall_tol, batch=True)
+        clamp=clamp, max_step=max_step, stall_tol=stall_tol, gamma_max=gamma_max, batch=True)
     if theta0.ndim == 1:
         theta0 = jnp.broadcast_to(theta0, (targets.shape[0], theta0.shape[0]))
     state = _run_batch(method, task, arm, targets, theta0, settings, max_iter)

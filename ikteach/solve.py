@@ -18,7 +18,10 @@ import jax.numpy as jnp
 import numpy as np
 
 from ._validate import as_array, as_count, as_number
+from .ccd import CCDMethod
 from .dls import dls_step
+from .fabrik import FABRIKMethod
+from .sdls import GAMMA_MAX, SDLSMethod
 from .jt import jt_step
 from .limits import cap_step, clamp_error
 from .pinv import DEFAULT_RCOND, pinv_step
@@ -46,6 +49,7 @@ class Settings(NamedTuple):
     clamp: float      # D_max; inf for no clamp
     max_step: float   # per-joint cap in radians; inf for none
     stall_tol: float  # 0 disables the stall stop
+    gamma_max: float = np.pi / 4  # SDLS: largest joint turn per step (Buss & Kim 2005)
 
 
 def _jt(J, e, s):
@@ -80,6 +84,7 @@ class UserStep:
 
 
 METHODS = {"jt": JacobianMethod(_jt), "pinv": JacobianMethod(_pinv), "dls": JacobianMethod(_dls)}
+METHODS.update(sdls=SDLSMethod(), ccd=CCDMethod(), fabrik=FABRIKMethod())
 
 
 @dataclasses.dataclass(frozen=True)
@@ -205,7 +210,7 @@ def resolve_method(method):
 
 
 def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, max_step,
-                  stall_tol, batch=False):
+                  stall_tol, gamma_max=GAMMA_MAX, batch=False):
     """Validate everything solve/solve_batch take.
 
     Returns (task, target, theta0, settings, max_iter). With batch=True, target holds
@@ -231,15 +236,16 @@ def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, 
         clamp=np.inf if clamp is None else as_number(clamp, "clamp", minimum=0, strict=True),
         max_step=np.inf if max_step is None else as_number(max_step, "max_step", minimum=0, strict=True),
         stall_tol=as_number(stall_tol, "stall_tol", minimum=0),
+        gamma_max=as_number(gamma_max, "gamma_max", minimum=0, strict=True),
     )
     return task, jnp.asarray(target), jnp.asarray(theta0), settings, max_iter
 
 
 def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DEFAULT_DAMPING,
-          rcond=DEFAULT_RCOND, clamp=None, max_step=None, stall_tol=None):
+          rcond=DEFAULT_RCOND, clamp=None, max_step=None, stall_tol=None, gamma_max=GAMMA_MAX):
     """Solve F(theta) = target from theta0 by repeated steps of `method`.
 
-    method    "jt", "pinv", "dls", or a function step(J, e) -> delta_theta
+    method    "jt", "pinv", "dls", "sdls", "ccd", "fabrik", or a function step(J, e) -> delta_theta
               (it may raise ik.StopSolve to end the solve "stalled": its own stop rule).
     tol       stop "converged" when ||e|| < tol.
     max_iter  stop "max_iter" after this many steps.
@@ -248,12 +254,13 @@ def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DE
     max_step  cap on any joint's change per step, in radians.
     stall_tol stop "stalled" when sum |delta_theta_i| < stall_tol
               (default STALL_FRACTION * total link length; 0 turns it off).
+    gamma_max SDLS's largest joint turn per step (default pi/4).
     Returns a Result: theta, status, iterations, error (final ||e||) and trace.
     """
     method = resolve_method(method)
     task, target, theta0, settings, max_iter = check_problem(
         arm, target, theta0, tol=tol, max_iter=max_iter, damping=damping, rcond=rcond,
-        clamp=clamp, max_step=max_step, stall_tol=stall_tol)
+        clamp=clamp, max_step=max_step, stall_tol=stall_tol, gamma_max=gamma_max)
     args = (method, task, arm, target, theta0, settings, max_iter, True)
     state = (_run_jit if traceable(*args[:6]) else _run_eager)(*args)
     k = int(state.i)

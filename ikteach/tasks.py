@@ -9,6 +9,7 @@ import dataclasses
 from .chain import Chain, reach
 from .jacobian import jacobian
 from .kinematics import fk
+from .tree import TreeTask
 
 
 @dataclasses.dataclass(frozen=True)
@@ -35,6 +36,7 @@ class PositionTask:
 
 
 TASKS = [PositionTask()]
+TASKS.append(TreeTask())  # trees: one target per end effector (ikteach/tree.py)
 
 
 def task_for(arm, target_shape, name="target"):

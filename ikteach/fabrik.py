@@ -1,0 +1,80 @@
+"""FABRIK, forward and backward reaching IK (Aristidou & Lasenby 2011), on chains.
+
+FABRIK works on joint positions p_0..p_n (p_n the end effector) and link lengths d_i:
+  forward:  p_n <- t,     p_i <- p_{i+1} + d_i (p_i - p_{i+1}) / |p_i - p_{i+1}|,  i = n-1..0
+  backward: p_0 <- base,  p_{i+1} <- p_i + d_i (p_{i+1} - p_i) / |p_{i+1} - p_i|,  i = 0..n-1
+and, when |t - p_0| > sum d_i (out of reach), stretches the chain straight at t.
+Our joints are hinges, so the new points are turned back into angles: each joint in turn,
+base first, is turned (ccd_angle) to point its link at the new p_{i+1}. For a planar arm
+this reproduces the points exactly; for a spatial hinge chain it is the nearest the hinges
+allow, one joint at a time.
+"""
+import dataclasses
+
+import jax
+import jax.numpy as jnp
+
+from .ccd import as_point3, ccd_angle, require_chain
+from .kinematics import joint_frames
+
+EPS = 1e-12
+
+
+def _toward(a, b, d):
+    """The point at distance d from a in the direction of b (a itself when b = a)."""
+    v = b - a
+    n = jnp.linalg.norm(v)
+    return a + d * v / jnp.where(n > EPS, n, 1.0) * (n > EPS)
+
+
+def fabrik_forward(points, lengths, target):
+    """Forward reaching: end effector onto the target, then each joint back along its link."""
+    n = lengths.shape[0]
+    points = points.at[n].set(target)
+    for i in range(n - 1, -1, -1):
+        points = points.at[i].set(_toward(points[i + 1], points[i], lengths[i]))
+    return points
+
+
+def fabrik_backward(points, lengths, base):
+    """Backward reaching: the root back onto the base, then each joint out along its link."""
+    points = points.at[0].set(base)
+    for i in range(lengths.shape[0]):
+        points = points.at[i + 1].set(_toward(points[i], points[i + 1], lengths[i]))
+    return points
+
+
+def fabrik_stretch(points, lengths, target):
+    """Out of reach: every link points straight at the target, p_{i+1} = p_i + d_i unit(t - p_i)."""
+    for i in range(lengths.shape[0]):
+        points = points.at[i + 1].set(_toward(points[i], target, lengths[i]))
+    return points
+
+
+def fabrik_pass(points, lengths, target):
+    """One FABRIK iteration on the points (stretch when the target is out of reach)."""
+    points, lengths, target = jnp.asarray(points), jnp.asarray(lengths), jnp.asarray(target)
+    reachable = jnp.linalg.norm(target - points[0]) <= jnp.sum(lengths)
+    inside = fabrik_backward(fabrik_forward(points, lengths, target), lengths, points[0])
+    return jnp.where(reachable, inside, fabrik_stretch(points, lengths, target))
+
+
+def angles_toward_points(arm, theta, points):
+    """Turn joints 0..n-1 in order so that each link points at the new position points[i+1]."""
+    def turn(i, q):
+        positions, axes, _ = joint_frames(arm, q)
+        return q.at[i].add(ccd_angle(axes[i], positions[i], positions[i + 1], points[i + 1]))
+
+    return jax.lax.fori_loop(0, arm.n_joints, turn, jnp.asarray(theta))
+
+
+@dataclasses.dataclass(frozen=True)
+class FABRIKMethod:
+    """FABRIK as a solve method: one pass on the points, then back to angles."""
+
+    def delta(self, task, arm, target, theta, e, settings):
+        require_chain(arm, "fabrik")
+        positions = joint_frames(arm, theta)[0]
+        lengths = jnp.linalg.norm(jnp.asarray(arm.offsets), axis=1)
+        points = fabrik_pass(positions, lengths, as_point3(arm, target))
+        return angles_toward_points(arm, theta, points) - theta

@@ -1,0 +1,67 @@
+"""Selectively damped least squares (Buss & Kim 2005): damp each singular direction by itself.
+
+With J = sum_i sigma_i u_i v_i^T, the pseudoinverse step is sum_i (alpha_i / sigma_i) v_i,
+alpha_i = u_i . e. SDLS bounds how far each term may turn the joints, by comparing how far
+the end effectors are asked to move along u_i (N_i) with how far they would move if the
+joints turned as 1/sigma_i v_i asks (M_i):
+
+  N_i = sum_k ||u_{k,i}||                       (u_{k,i}: effector k's rows of u_i)
+  M_i = (1/sigma_i) sum_l |v_{l,i}| sum_k ||J_{k,l}||   (J_{k,l}: effector k's rows of column l)
+  gamma_i = min(1, N_i / M_i) gamma_max
+  phi_i = ClampMaxAbs((alpha_i / sigma_i) v_i, gamma_i)
+  delta_theta = ClampMaxAbs(sum_i phi_i, gamma_max)
+
+ClampMaxAbs(w, d) scales w down so that max_l |w_l| <= d (ik.cap_step). The paper uses
+gamma_max = pi/4; so no joint ever turns by more than gamma_max in one step.
+"""
+import dataclasses
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from .limits import cap_step, clamp_error
+
+GAMMA_MAX = np.pi / 4   # Buss & Kim 2005, section 4
+NEAR_ZERO = 1e-10       # singular values below this are skipped (as in Buss's demo code)
+
+
+def block_norms(A, block):
+    """Norms of the `block`-row pieces of every column of A (rows = effectors x block): (k, cols)."""
+    k = A.shape[0] // block
+    return jnp.linalg.norm(A.reshape(k, block, A.shape[1]), axis=1)
+
+
+def sdls_gamma(U, sigma, Vt, J, gamma_max, block):
+    """gamma_i = min(1, N_i / M_i) gamma_max for every singular direction i (see module doc)."""
+    N = block_norms(U, block).sum(axis=0)
+    column_size = block_norms(J, block).sum(axis=0)              # sum_k ||J_{k,l}||
+    safe_sigma = jnp.where(sigma > NEAR_ZERO, sigma, 1.0)
+    M = (jnp.abs(Vt) @ column_size) / safe_sigma
+    ratio = jnp.where(M > 0, N / jnp.where(M > 0, M, 1.0), 1.0)
+    return gamma_max * jnp.minimum(1.0, ratio)
+
+
+def sdls_step(J, e, gamma_max=GAMMA_MAX, block=None):
+    """delta_theta = ClampMaxAbs(sum_i ClampMaxAbs((u_i.e / sigma_i) v_i, gamma_i), gamma_max).
+
+    J has one block of `block` rows per end effector (default: all rows, one effector).
+    """
+    J, e = jnp.asarray(J), jnp.asarray(e)
+    block = J.shape[0] if block is None else block
+    U, sigma, Vt = jnp.linalg.svd(J, full_matrices=False)
+    gamma = sdls_gamma(U, sigma, Vt, J, gamma_max, block)
+    keep = sigma > NEAR_ZERO
+    coeff = jnp.where(keep, (U.T @ e) / jnp.where(keep, sigma, 1.0), 0.0)
+    phi = jax.vmap(cap_step)(coeff[:, None] * Vt, gamma)          # one row per direction
+    return cap_step(phi.sum(axis=0), gamma_max)
+
+
+@dataclasses.dataclass(frozen=True)
+class SDLSMethod:
+    """SDLS as a solve method: e is clamped to D_max (clamp=) first, blocks per end effector."""
+
+    def delta(self, task, arm, target, theta, e, settings):
+        J = task.jacobian(arm, theta)
+        block = getattr(task, "block_size", J.shape[0])
+        return sdls_step(J, clamp_error(e, settings.clamp), settings.gamma_max, block)

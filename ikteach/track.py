@@ -1,0 +1,87 @@
+"""Following moving targets: one IK step per time step (Buss's demo protocol).
+
+At each time step the targets move, then the method takes ONE step from the current theta
+(no iterating to convergence). Reported per step: the sum over end effectors of the
+distance to its target after the step, and the joint motion.
+"""
+import dataclasses
+from functools import partial
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from ._validate import as_array, as_number
+from .limits import cap_step
+from .pinv import DEFAULT_RCOND
+from .sdls import GAMMA_MAX
+from .solve import DEFAULT_DAMPING, Settings, resolve_method
+from .tasks import task_for
+
+
+@dataclasses.dataclass(frozen=True)
+class TrackResult:
+    """theta (T+1, n) from the start; error (T,) = sum_k |t_k - x_k| after each step."""
+    theta: np.ndarray
+    error: np.ndarray
+
+    @property
+    def mean_error(self):
+        return float(np.mean(self.error))
+
+    @property
+    def jitter(self):
+        """Mean over steps of sum_j |delta_theta_j(t) - delta_theta_j(t-1)|: how much the
+        joint velocities change from one step to the next (0 for smooth motion)."""
+        step = np.diff(self.theta, axis=0)
+        return float(np.mean(np.abs(np.diff(step, axis=0)).sum(axis=1)))
+
+
+def clamp_blocks(e, block, d_max):
+    """Clamp each effector's error |e_k| to at most D_max (Buss's per-effector clamp)."""
+    parts = e.reshape(-1, block)
+    norm = jnp.linalg.norm(parts, axis=1, keepdims=True)
+    scale = jnp.where(norm > d_max, d_max / jnp.where(norm > 0, norm, 1.0), 1.0)
+    return (parts * scale).reshape(-1)
+
+
+@partial(jax.jit, static_argnames=("method", "task"))
+def _track(method, task, arm, targets, theta0, settings, d_max):
+    block = getattr(task, "block_size", None)
+
+    def step(theta, target):
+        e = task.error(arm, target, theta)
+        e = clamp_blocks(e, block or e.shape[0], d_max)
+        delta = cap_step(method.delta(task, arm, target, theta, e, settings), settings.max_step)
+        theta = theta + delta
+        e_after = task.error(arm, target, theta)
+        err = jnp.sum(jnp.linalg.norm(e_after.reshape(-1, block or e_after.shape[0]), axis=1))
+        return theta, (theta, err)
+
+    _, (thetas, errors) = jax.lax.scan(step, theta0, targets)
+    return jnp.vstack([theta0[None], thetas]), errors
+
+
+def track(arm, targets, theta0=None, method="dls", damping=DEFAULT_DAMPING, rcond=DEFAULT_RCOND,
+          clamp=None, max_step=None, gamma_max=GAMMA_MAX):
+    """Follow targets[0], targets[1], ... with one step of `method` each (Buss's protocol).
+
+    targets  (T, *target shape): one target (or one per end effector) per time step.
+    clamp    D_max: each end effector's error is clamped to at most D_max before the step.
+    max_step cap on any joint's change per step (radians).
+    """
+    method = resolve_method(method)
+    targets = as_array(targets, "targets")
+    if targets.ndim < 2:
+        raise ValueError(f"targets: expected one target per time step, got shape {targets.shape}")
+    task = task_for(arm, targets.shape[1:], "targets")
+    theta0 = np.zeros(arm.n_joints) if theta0 is None else as_array(theta0, "theta0", shape=(arm.n_joints,))
+    settings = Settings(
+        tol=0.0, damping=as_number(damping, "damping", minimum=0),
+        rcond=as_number(rcond, "rcond", minimum=0), clamp=np.inf,
+        max_step=np.inf if max_step is None else as_number(max_step, "max_step", minimum=0, strict=True),
+        stall_tol=0.0, gamma_max=as_number(gamma_max, "gamma_max", minimum=0, strict=True))
+    d_max = np.inf if clamp is None else as_number(clamp, "clamp", minimum=0, strict=True)
+    thetas, errors = _track(method, task, arm, jnp.asarray(targets), jnp.asarray(theta0), settings,
+                            jnp.asarray(d_max))
+    return TrackResult(np.asarray(thetas), np.asarray(errors))

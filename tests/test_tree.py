@@ -1,0 +1,129 @@
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+import ikteach as ik
+from ikteach import buss_trees
+from ikteach.tree import ancestors
+
+Y = buss_trees.y_tree()
+DOUBLE_Y = buss_trees.double_y_tree()
+R2, H3 = 1 / np.sqrt(2), np.sqrt(3) / 2
+
+
+@st.composite
+def random_trees(draw, max_joints=8, max_effectors=3):
+    n = draw(st.integers(1, max_joints))
+    m = draw(st.integers(1, max_effectors))
+    rng = np.random.default_rng(draw(st.integers(0, 2**31 - 1)))
+    parents = [-1] + [int(rng.integers(0, j)) for j in range(1, n)]
+    return ik.tree(rng.normal(size=(n, 3)), rng.normal(size=(n, 3)), parents,
+                   rng.normal(size=(m, 3)), rng.integers(0, n, size=m).tolist())
+
+
+@given(random_trees(), st.integers(0, 2**31 - 1))
+def test_stacked_jacobian_agrees_with_autodiff_on_random_trees(arm, seed):
+    theta = np.random.default_rng(seed).uniform(-np.pi, np.pi, arm.n_joints)
+    J = ik.tree_jacobian(arm, theta)
+    assert J.shape == (3 * arm.n_effectors, arm.n_joints)
+    np.testing.assert_allclose(J, ik.tree_jacobian_autodiff(arm, theta), atol=1e-10)
+
+
+@pytest.mark.parametrize("arm", [Y, DOUBLE_Y], ids=["Y", "double Y"])
+def test_buss_tree_jacobians_agree_with_autodiff(arm):
+    theta = np.random.default_rng(1).uniform(-1, 1, arm.n_joints)
+    np.testing.assert_allclose(ik.tree_jacobian(arm, theta), ik.tree_jacobian_autodiff(arm, theta),
+                               atol=1e-10)
+
+
+def test_y_tree_matches_the_published_rest_pose():
+    # BuildTreeYShape: nodes 0-6 joints, 7-8 effectors
+    p, w, x = map(np.asarray, ik.tree_frames(Y, np.zeros(7)))
+    np.testing.assert_allclose(p, [[0, -.5, 0], [0, .4, 0], [0, .4, 0], [.5, 1, 0], [-.5, 1, 0],
+                                   [.7, 1.3, 0], [-.8, 1.5, 0]])
+    u1 = [np.sqrt(14) / 8, 1 / 8, 7 / 8]
+    np.testing.assert_allclose(w, [[0, 0, 1]] * 3 + [[1, 0, 0]] * 2 + [u1] * 2)
+    np.testing.assert_allclose(x, [[.7, 2, 0], [-.8, 1.9, 0]])
+    assert Y.n_joints == 7 and Y.n_effectors == 2
+
+
+def test_y_tree_branches_each_move_only_their_own_effector():
+    assert ancestors(Y).tolist() == [[1, 1, 0, 1, 0, 1, 0], [1, 0, 1, 0, 1, 0, 1]]
+    x0 = np.asarray(ik.tree_fk(Y, np.zeros(7)))
+    theta = np.zeros(7)
+    theta[1] = np.pi / 2                 # left fork joint about z through (0, 0.4, 0)
+    x = np.asarray(ik.tree_fk(Y, theta))
+    np.testing.assert_allclose(x[1], x0[1], atol=1e-12)
+    np.testing.assert_allclose(x[0], [0 - 1.6, 0.4 + 0.7, 0], atol=1e-12)  # (0.7, 1.6) turned 90°
+
+
+def test_double_y_tree_matches_the_published_rest_pose_and_structure():
+    p, w, x = map(np.asarray, ik.tree_frames(DOUBLE_Y, np.zeros(25)))
+    assert DOUBLE_Y.n_joints == 25 and DOUBLE_Y.n_effectors == 4
+    y0 = -0.5 + 0.5 * R2
+    np.testing.assert_allclose(x, [[0.5 * R2 + 1.5 * H3, y0 + 0.75, 0], [0.5 * R2 + 1.5 * H3, y0 + 1.5 * H3, 0],
+                                   [-0.5 * R2 - 1.5 * H3, y0 + 1.5 * H3, 0], [-0.5 * R2 - 1.5 * H3, y0 + 0.75, 0]])
+    np.testing.assert_allclose(p[:4], [[0, -1.5, 0], [0, -1, 0], [0, -1, 0], [0, -0.5, 0]])
+    np.testing.assert_allclose(w[0], [np.sqrt(14) / 8, 1 / 8, 7 / 8])
+    # the demo's node parents, with effector nodes 11, 16, 23, 28 removed from the numbering
+    paths = [{10, 9, 8, 7, 5, 3, 2, 1, 0}, {14, 13, 12, 11, 6, 3, 2, 1, 0},
+             {20, 19, 18, 16, 15, 4, 2, 1, 0}, {24, 23, 22, 21, 17, 4, 2, 1, 0}]
+    assert [set(np.flatnonzero(row)) for row in ancestors(DOUBLE_Y)] == paths
+
+
+def test_targets_are_the_published_sums_of_sines():
+    t = 0.3
+    np.testing.assert_allclose(buss_trees.y_targets(t)[0, 0],
+                               [2 + 1.5 * np.sin(1.8), 1.2 + 0.2 * np.sin(2.1), 0.3 + 0.2 * np.sin(2.4)])
+    np.testing.assert_allclose(buss_trees.double_y_targets(t)[0, 3],
+                               [-1.6 + 1.6 * np.sin(1.2), 0.3 + 0.6 * np.sin(1.2), -0.2 + 0.6 * np.sin(0.9)])
+    assert buss_trees.double_y_targets(buss_trees.times(10)).shape == (10, 4, 3)
+
+
+@pytest.mark.parametrize("method", ["dls", "sdls", "pinv"])
+def test_solve_reaches_one_target_per_effector(method):
+    goal = np.random.default_rng(2).uniform(-0.6, 0.6, 25)
+    targets = np.asarray(ik.tree_fk(DOUBLE_Y, goal))
+    res = ik.solve(DOUBLE_Y, targets, np.zeros(25), method=method, damping=0.1, tol=1e-4, max_iter=2000)
+    assert res.status == "converged", res
+    assert np.all(np.linalg.norm(np.asarray(ik.tree_fk(DOUBLE_Y, res.theta)) - targets, axis=1) < 1e-4)
+
+
+def test_out_of_reach_tree_targets_stall_without_nan():
+    targets = np.array([[10.0, 0, 0], [-10.0, 0, 0]])
+    # with Buss's error clamp (D_max = 0.4), as in his demo; unclamped SDLS keeps swinging here
+    res = ik.solve(Y, targets, np.zeros(7), method="sdls", clamp=buss_trees.D_MAX, max_iter=3000)
+    assert res.status == "stalled"
+    assert np.all(np.isfinite(res.theta)) and np.isfinite(res.error)
+
+
+def test_solve_batch_on_a_tree():
+    rng = np.random.default_rng(4)
+    targets = np.stack([np.asarray(ik.tree_fk(Y, rng.uniform(-0.5, 0.5, 7))) for _ in range(3)])
+    batch = ik.solve_batch(Y, targets, np.zeros(7), method="dls", damping=0.1, tol=1e-4, max_iter=2000)
+    assert batch.counts()["converged"] == 3
+
+
+def test_tracking_follows_the_y_targets():
+    targets = buss_trees.y_targets(buss_trees.times(300))
+    res = ik.track(Y, targets, method="sdls", clamp=buss_trees.D_MAX)
+    assert res.theta.shape == (301, 7) and res.error.shape == (300,)
+    assert np.all(np.isfinite(res.theta))
+    # target 0 is at times out of reach, so the error never reaches 0; but following the
+    # targets must do far better than standing still in the rest pose
+    still = np.linalg.norm(targets - np.asarray(ik.tree_fk(Y, np.zeros(7))), axis=2).sum(axis=1)
+    assert res.error.mean() < 0.4 * still.mean()
+
+
+def test_bad_tree_input_names_the_parameter():
+    with pytest.raises(ValueError, match="parents"):
+        ik.tree(np.zeros((2, 3)), np.eye(3)[:2], [-1, 1], [[0, 0, 1]], [1])
+    with pytest.raises(ValueError, match="effector_parents"):
+        ik.tree(np.zeros((2, 3)), np.eye(3)[:2], [-1, 0], [[0, 0, 1]], [2])
+    with pytest.raises(ValueError, match="axes"):
+        ik.tree(np.zeros((2, 3)), np.zeros((2, 3)), [-1, 0], [[0, 0, 1]], [1])
+    with pytest.raises(ValueError, match="target"):
+        ik.solve(Y, np.zeros(3), np.zeros(7))
+    with pytest.raises(ValueError, match="method"):
+        ik.solve(Y, np.zeros((2, 3)), np.zeros(7), method="ccd")
