@@ -180,14 +180,25 @@ def _run_eager(method, task, arm, target, theta0, settings, max_iter, record):
     return state
 
 
+_TRACEABLE = {}
+
+
 def traceable(method, task, arm, target, theta0, settings):
-    """Can JAX trace the method (pure jax.numpy), or does it need eager execution?"""
-    try:
-        jax.eval_shape(lambda q: method.delta(task, arm, target, q, task.error(arm, target, q),
-                                              settings), theta0)
-    except Exception:
-        return False
-    return True
+    """Can JAX trace the method (pure jax.numpy), or does it need eager execution?
+
+    Built-in methods are JAX code; a user's step is tried once per problem shape.
+    """
+    if method in METHODS.values():
+        return True
+    key = (method, task, type(arm), arm.dim, target.shape, theta0.shape)
+    if key not in _TRACEABLE:
+        try:
+            jax.eval_shape(lambda q: method.delta(task, arm, target, q, task.error(arm, target, q),
+                                                  settings), theta0)
+            _TRACEABLE[key] = True
+        except Exception:
+            _TRACEABLE[key] = False
+    return _TRACEABLE[key]
 
 
 def resolve_method(method):
