@@ -16,6 +16,9 @@ from .limits import clamp_error, cap_step  # noqa: E402
 from .solve import solve, Result, Trace, STATUSES, METHODS  # noqa: E402
 from .batch import solve_batch, BatchResult  # noqa: E402
 from . import notebook  # noqa: E402
+from .pose import fk_pose, rotation_log, rotation_exp, pose_errors, make_pose, PoseTask  # noqa: E402
+from .robots import ur5, iiwa14  # noqa: E402
+from . import robots  # noqa: E402
 
 __all__ = [
     "Chain", "planar_chain", "serial_chain", "reach",
@@ -25,5 +28,7 @@ __all__ = [
     "clamp_error", "cap_step",
     "solve", "Result", "Trace", "STATUSES", "METHODS",
     "solve_batch", "BatchResult", "notebook",
+    "fk_pose", "rotation_log", "rotation_exp", "pose_errors", "make_pose", "PoseTask",
+    "ur5", "iiwa14", "robots",
 ]
 __version__ = "0.1.0"

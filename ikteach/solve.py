@@ -192,7 +192,7 @@ def resolve_method(method):
 
 
 def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, max_step,
-                  stall_tol, batch=False):
+                  stall_tol, batch=False, weights=None):
     """Validate everything solve/solve_batch take.
 
     Returns (task, target, theta0, settings, max_iter). With batch=True, target holds
@@ -203,6 +203,11 @@ def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, 
     if batch and target.ndim < 2:
         raise ValueError(f"targets: expected one target per row, got shape {target.shape}")
     task = task_for(arm, target.shape[1:] if batch else target.shape, name)
+    if weights is not None:  # pose targets: weights (position, orientation) on the error
+        if not hasattr(task, "weighted"):
+            raise ValueError("weights: only pose targets (a 4x4 transform for a spatial "
+                             "chain) take weights (position_weight, orientation_weight)")
+        task = task.weighted(weights)
     n = arm.n_joints
     if batch and np.ndim(theta0) == 2:
         theta0 = as_array(theta0, "theta0", shape=(target.shape[0], n))
@@ -223,7 +228,7 @@ def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, 
 
 
 def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DEFAULT_DAMPING,
-          rcond=DEFAULT_RCOND, clamp=None, max_step=None, stall_tol=None):
+          rcond=DEFAULT_RCOND, clamp=None, max_step=None, stall_tol=None, weights=None):
     """Solve F(theta) = target from theta0 by repeated steps of `method`.
 
     method    "jt", "pinv", "dls", or a function step(J, e) -> delta_theta.
@@ -234,12 +239,13 @@ def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DE
     max_step  cap on any joint's change per step, in radians.
     stall_tol stop "stalled" when sum |delta_theta_i| < stall_tol
               (default STALL_FRACTION * total link length; 0 turns it off).
+    weights   for a 4x4 pose target: (position_weight, orientation_weight), default (1, 1).
     Returns a Result: theta, status, iterations, error (final ||e||) and trace.
     """
     method = resolve_method(method)
     task, target, theta0, settings, max_iter = check_problem(
         arm, target, theta0, tol=tol, max_iter=max_iter, damping=damping, rcond=rcond,
-        clamp=clamp, max_step=max_step, stall_tol=stall_tol)
+        clamp=clamp, max_step=max_step, stall_tol=stall_tol, weights=weights)
     args = (method, task, arm, target, theta0, settings, max_iter, True)
     state = (_run_jit if traceable(*args[:6]) else _run_eager)(*args)
     k = int(state.i)
