@@ -19,6 +19,7 @@ from . import notebook  # noqa: E402
 from .pose import fk_pose, rotation_log, rotation_exp, pose_errors, make_pose, PoseTask  # noqa: E402
 from .robots import ur5, iiwa14  # noqa: E402
 from . import robots  # noqa: E402
+from . import scene, workspace  # noqa: E402
 
 __all__ = [
     "Chain", "planar_chain", "serial_chain", "reach",
@@ -29,6 +30,6 @@ __all__ = [
     "solve", "Result", "Trace", "STATUSES", "METHODS",
     "solve_batch", "BatchResult", "notebook",
     "fk_pose", "rotation_log", "rotation_exp", "pose_errors", "make_pose", "PoseTask",
-    "ur5", "iiwa14", "robots",
+    "ur5", "iiwa14", "robots", "scene", "workspace",
 ]
 __version__ = "0.1.0"
