@@ -16,7 +16,10 @@ lab: $(STAMP)
 	$(VENV)/bin/jupyter lab --notebook-dir=notebooks
 
 test: $(STAMP)
-	$(PY) -m pytest -n 2 tests $(wildcard notebooks/*.ipynb) --nbval --nbval-sanitize-with tests/nbval_sanitize.cfg
+	$(PY) -m pytest -n 2 --dist loadfile tests $(wildcard notebooks/*.ipynb) --nbval --nbval-sanitize-with tests/nbval_sanitize.cfg
 
 clean:
 	rm -rf $(VENV) .pytest_cache .hypothesis
+
+bench: $(STAMP)
+	$(PY) benchmarks/sweep.py
