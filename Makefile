@@ -29,3 +29,6 @@ exercises: $(STAMP)
 
 clean:
 	rm -rf $(VENV) .pytest_cache .hypothesis
+
+bench: $(STAMP)
+	$(PY) benchmarks/sweep.py

@@ -25,6 +25,10 @@ from .tree import Tree, tree, tree_fk, tree_frames, tree_jacobian, tree_jacobian
 from .track import track, TrackResult  # noqa: E402
 from . import buss_trees, tree_plot  # noqa: E402
 from . import plot, demo  # noqa: E402
+from .pose import fk_pose, rotation_log, rotation_exp, pose_errors, make_pose, PoseTask  # noqa: E402
+from .robots import ur5, iiwa14  # noqa: E402
+from . import robots  # noqa: E402
+from . import scene, workspace  # noqa: E402
 
 __all__ = [
     "Chain", "planar_chain", "serial_chain", "reach",
@@ -38,5 +42,7 @@ __all__ = [
     "sdls_step", "GAMMA_MAX", "ccd_sweep", "ccd_angle", "fabrik_pass",
     "Tree", "tree", "tree_fk", "tree_frames", "tree_jacobian", "tree_jacobian_autodiff",
     "track", "TrackResult", "buss_trees", "tree_plot", "plot", "demo",
+    "fk_pose", "rotation_log", "rotation_exp", "pose_errors", "make_pose", "PoseTask",
+    "ur5", "iiwa14", "robots", "scene", "workspace",
 ]
 __version__ = "0.1.0"

@@ -221,7 +221,8 @@ def resolve_method(method):
 
 
 def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, max_step,
-                  stall_tol, gamma_max=GAMMA_MAX, batch=False):
+                  stall_tol, gamma_max=GAMMA_MAX, batch=False,
+                  weights=None):
     """Validate everything solve/solve_batch take.
 
     Returns (task, target, theta0, settings, max_iter). With batch=True, target holds
@@ -232,6 +233,11 @@ def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, 
     if batch and target.ndim < 2:
         raise ValueError(f"targets: expected one target per row, got shape {target.shape}")
     task = task_for(arm, target.shape[1:] if batch else target.shape, name)
+    if weights is not None:  # pose targets: weights (position, orientation) on the error
+        if not hasattr(task, "weighted"):
+            raise ValueError("weights: only pose targets (a 4x4 transform for a spatial "
+                             "chain) take weights (position_weight, orientation_weight)")
+        task = task.weighted(weights)
     n = arm.n_joints
     if batch and np.ndim(theta0) == 2:
         theta0 = as_array(theta0, "theta0", shape=(target.shape[0], n))
@@ -253,7 +259,8 @@ def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, 
 
 
 def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DEFAULT_DAMPING,
-          rcond=DEFAULT_RCOND, clamp=None, max_step=None, stall_tol=None, gamma_max=GAMMA_MAX):
+          rcond=DEFAULT_RCOND, clamp=None, max_step=None, stall_tol=None, gamma_max=GAMMA_MAX,
+          weights=None):
     """Solve F(theta) = target from theta0 by repeated steps of `method`.
 
     method    "jt", "pinv", "dls", "sdls", "ccd", "fabrik", or a function step(J, e) -> delta_theta
@@ -266,12 +273,14 @@ def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DE
     stall_tol stop "stalled" when sum |delta_theta_i| < stall_tol
               (default STALL_FRACTION * total link length; 0 turns it off).
     gamma_max SDLS's largest joint turn per step (default pi/4).
+    weights   for a 4x4 pose target: (position_weight, orientation_weight), default (1, 1).
     Returns a Result: theta, status, iterations, error (final ||e||) and trace.
     """
     method = resolve_method(method)
     task, target, theta0, settings, max_iter = check_problem(
         arm, target, theta0, tol=tol, max_iter=max_iter, damping=damping, rcond=rcond,
-        clamp=clamp, max_step=max_step, stall_tol=stall_tol, gamma_max=gamma_max)
+        clamp=clamp, max_step=max_step, stall_tol=stall_tol, gamma_max=gamma_max,
+        weights=weights)
     args = (method, task, arm, target, theta0, settings, max_iter, True)
     state = (_run_jit if traceable(*args[:6]) else _run_eager)(*args)
     k = int(state.i)

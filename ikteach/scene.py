@@ -1,0 +1,166 @@
+"""3-D scenes of an arm with pyvista: links as tubes, joints as short cylinders along their
+axes, frames as axes triads (x red, y green, z blue), the end effector's path as a trail.
+
+Off screen (pv.OFF_SCREEN, set by ik.notebook.setup() when headless) a scene is rendered
+to an image; show() puts that image in the notebook as a PNG, or opens pyvista's live
+view when the user's Jupyter has an interactive backend.
+"""
+import io
+
+import numpy as np
+
+from .kinematics import joint_frames
+from .chain import reach
+
+COLORS = {"link": "#4c72b0", "joint": "#dd8452", "base": "#555555", "trail": "#c44e52",
+          "target": "#8172b3"}
+TRIAD_COLORS = ("#d62728", "#2ca02c", "#1f77b4")  # x, y, z
+WINDOW = (480, 360)
+
+
+def _pv():
+    import pyvista as pv
+    try:  # vtk's X11 warnings go straight to stderr; keep errors only
+        import vtk
+        vtk.vtkLogger.SetStderrVerbosity(vtk.vtkLogger.VERBOSITY_ERROR)
+    except (ImportError, AttributeError):
+        pass
+    return pv
+
+
+def frames(arm, theta):
+    """World joint positions (n+1, 3), world joint axes (n, 3) and the 4x4 end pose, as numpy."""
+    positions, axes, R = (np.asarray(x) for x in joint_frames(arm, theta))
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = R, positions[-1]
+    return positions, axes, T
+
+
+def triad(T, size):
+    """Three arrows along the columns of T's rotation, from T's origin: [(mesh, colour), ...]."""
+    pv = _pv()
+    T = np.asarray(T, dtype=float)
+    return [(pv.Arrow(start=T[:3, 3], direction=T[:3, k], scale=size, tip_length=0.3,
+                      tip_radius=0.1, shaft_radius=0.035), TRIAD_COLORS[k]) for k in range(3)]
+
+
+def arm_meshes(arm, theta, scale=None):
+    """The arm as meshes: [(mesh, colour), ...] with link tubes, joint cylinders and the base."""
+    pv = _pv()
+    scale = float(reach(arm)) if scale is None else scale
+    positions, axes, _ = frames(arm, theta)
+    parts = [(pv.Cylinder(center=positions[0] - [0, 0, 0.03 * scale], direction=(0, 0, 1),
+                          radius=0.09 * scale, height=0.06 * scale), COLORS["base"])]
+    for a, b in zip(positions[:-1], positions[1:]):
+        if np.linalg.norm(b - a) > 1e-9:
+            parts.append((pv.Tube(pointa=a, pointb=b, radius=0.022 * scale, n_sides=16), COLORS["link"]))
+    for p, w in zip(positions[:-1], axes):
+        parts.append((pv.Cylinder(center=p, direction=w, radius=0.045 * scale,
+                                  height=0.11 * scale, resolution=24), COLORS["joint"]))
+    parts.append((pv.Sphere(center=positions[-1], radius=0.03 * scale), COLORS["joint"]))
+    return parts
+
+
+def trail_mesh(points, scale):
+    """The end effector's path as a thin tube through the points (k, 3)."""
+    pv = _pv()
+    points = np.asarray(points, dtype=float)
+    keep = np.r_[True, np.linalg.norm(np.diff(points, axis=0), axis=1) > 1e-9]
+    points = points[keep]
+    if len(points) < 2:
+        return None
+    return pv.lines_from_points(points).tube(radius=0.008 * scale, n_sides=8)
+
+
+def _camera(arm, scale):
+    base = np.asarray(arm.base, dtype=float)
+    focus = base + np.array([0.0, 0.0, 0.3 * scale])
+    eye = focus + scale * np.array([1.9, -2.3, 1.2])
+    return [tuple(eye), tuple(focus), (0.0, 0.0, 1.0)]
+
+
+def scene(arm, theta, target=None, trail=None, window_size=WINDOW, ghost=None, plotter=None):
+    """A pyvista Plotter showing the arm at theta.
+
+    target  a 3-vector (drawn as a sphere) or a 4x4 pose (drawn as a triad);
+    trail   end-effector positions (k, 3) drawn as a tube;
+    ghost   another theta (e.g. the start), drawn translucent.
+    The end effector's frame is drawn as a triad; the camera is fixed, so renders repeat.
+    """
+    pv = _pv()
+    scale = float(reach(arm))
+    p = plotter if plotter is not None else pv.Plotter(window_size=list(window_size),
+                                                       off_screen=pv.OFF_SCREEN or None)
+    p.set_background("white")
+    floor = pv.Plane(center=np.asarray(arm.base, dtype=float) - [0, 0, 0.061 * scale],
+                     direction=(0, 0, 1), i_size=2.4 * scale, j_size=2.4 * scale)
+    p.add_mesh(floor, color="#f2f2f2", ambient=0.6, diffuse=0.4)
+    if ghost is not None:
+        for mesh, colour in arm_meshes(arm, ghost, scale):
+            p.add_mesh(mesh, color=colour, opacity=0.25)
+    for mesh, colour in arm_meshes(arm, theta, scale):
+        p.add_mesh(mesh, color=colour, smooth_shading=True)
+    _, _, T = frames(arm, theta)
+    for mesh, colour in triad(T, 0.2 * scale):
+        p.add_mesh(mesh, color=colour)
+    if target is not None:
+        target = np.asarray(target, dtype=float)
+        if target.shape == (4, 4):
+            for mesh, colour in triad(target, 0.28 * scale):
+                p.add_mesh(mesh, color=colour, opacity=0.5)
+            centre = target[:3, 3]
+        else:
+            centre = np.append(target, 0.0)[:3] if target.shape == (2,) else target
+        p.add_mesh(pv.Sphere(center=centre, radius=0.025 * scale), color=COLORS["target"], opacity=0.6)
+    if trail is not None:
+        mesh = trail_mesh(trail, scale)
+        if mesh is not None:
+            p.add_mesh(mesh, color=COLORS["trail"])
+    p.camera_position = _camera(arm, scale)
+    p.camera.view_angle = 24.0
+    return p
+
+
+def render(plotter):
+    """Render off screen to an (h, w, 3) uint8 image; the plotter stays usable."""
+    return np.asarray(plotter.screenshot(return_img=True))
+
+
+def png_bytes(image):
+    """An (h, w, 3) uint8 image as PNG bytes."""
+    import matplotlib.image
+
+    buf = io.BytesIO()
+    matplotlib.image.imsave(buf, np.asarray(image), format="png")
+    return buf.getvalue()
+
+
+def show(plotter):
+    """Show a scene: a static PNG when rendering off screen (tests, CI, a committed notebook),
+    pyvista's interactive view when the user's Jupyter has a live backend."""
+    pv = _pv()
+    if pv.OFF_SCREEN or pv.global_theme.jupyter_backend in (None, "static", "none"):
+        from IPython.display import Image, display
+
+        image = render(plotter)
+        plotter.close()
+        display(Image(data=png_bytes(image), format="png"))
+        return None
+    return plotter.show()
+
+
+def solve_gif(arm, trace_theta, path, target=None, frames_max=30, fps=8, window_size=(320, 240)):
+    """Write a GIF of a solve: one frame per iterate of trace_theta (subsampled to at most
+    frames_max), the end effector's path so far drawn as a trail. Returns the path."""
+    pv = _pv()
+    thetas = np.asarray(trace_theta, dtype=float)
+    idx = np.unique(np.linspace(0, len(thetas) - 1, min(frames_max, len(thetas))).round().astype(int))
+    ends = np.array([frames(arm, q)[0][-1] for q in thetas])
+    p = pv.Plotter(window_size=list(window_size), off_screen=True)
+    p.open_gif(str(path), fps=fps)
+    for k in idx:
+        p.clear()
+        scene(arm, thetas[k], target=target, trail=ends[: k + 1], plotter=p)
+        p.write_frame()
+    p.close()
+    return path
