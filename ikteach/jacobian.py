@@ -1,10 +1,13 @@
 """The Jacobian J = dx/dtheta, three ways: geometric, automatic and finite differences."""
+from functools import partial
+
 import jax
 import jax.numpy as jnp
 
 from .kinematics import fk, joint_frames
 
 
+@partial(jax.jit, static_argnames="full")
 def jacobian(arm, theta, full=False):
     """Geometric Jacobian: column i is w_i x (p_e - p_i).
 
@@ -20,11 +23,13 @@ def jacobian(arm, theta, full=False):
     return jnp.vstack([linear, axes.T])
 
 
+@jax.jit
 def jacobian_autodiff(arm, theta):
     """J = dF/dtheta by forward-mode automatic differentiation (jax.jacfwd of fk)."""
     return jax.jacfwd(lambda t: fk(arm, t))(jnp.asarray(theta, dtype=float))
 
 
+@jax.jit
 def jacobian_fd(arm, theta, h=1e-6):
     """J by central differences: column i = (F(theta + h e_i) - F(theta - h e_i)) / 2h."""
     theta = jnp.asarray(theta, dtype=float)

@@ -1,4 +1,5 @@
 """Forward kinematics: x = F(theta), by walking the chain from base to end effector."""
+import jax
 import jax.numpy as jnp
 
 
@@ -13,29 +14,38 @@ def rotation_about(axis, angle):
     return jnp.eye(3) + jnp.sin(angle) * K + (1.0 - jnp.cos(angle)) * (K @ K)
 
 
+@jax.jit
 def joint_frames(arm, theta):
     """World joint positions p_0..p_n (p_n the end effector), world axes w_0..w_{n-1}
     and the end effector's rotation R.
 
     p_{i+1} = p_i + R_i o_i,  R_i = R_{i-1} Rot(a_i, theta_i),  w_i = R_{i-1} a_i.
     """
-    theta = jnp.asarray(theta)
-    R = jnp.eye(3)
-    p = jnp.asarray(arm.base)
-    positions, axes = [p], []
-    for i in range(arm.axes.shape[0]):
-        axes.append(R @ arm.axes[i])
-        R = R @ rotation_about(arm.axes[i], theta[i])
-        p = p + R @ arm.offsets[i]
-        positions.append(p)
-    return jnp.stack(positions), jnp.stack(axes), R
+    def link(carry, joint):
+        R, p = carry
+        axis, offset, angle = joint
+        w = R @ axis              # joint axis in the world, before the joint turns
+        R = R @ rotation_about(axis, angle)
+        p = p + R @ offset        # the next joint (or the end effector)
+        return (R, p), (p, w)
+
+    theta = jnp.asarray(theta, dtype=float)
+    if theta.shape != (arm.axes.shape[0],):
+        raise ValueError(f"theta: expected shape ({arm.axes.shape[0]},), one angle per joint, "
+                         f"got shape {theta.shape}")
+    base = jnp.asarray(arm.base, dtype=float)
+    joints = (jnp.asarray(arm.axes), jnp.asarray(arm.offsets), theta)
+    (R, _), (positions, axes) = jax.lax.scan(link, (jnp.eye(3), base), joints)
+    return jnp.vstack([base[None], positions]), axes, R
 
 
+@jax.jit
 def joint_positions(arm, theta):
     """Base, every joint and the end effector: shape (n + 1, d)."""
     return joint_frames(arm, theta)[0][:, : arm.dim]
 
 
+@jax.jit
 def fk(arm, theta):
     """End-effector position x = F(theta): shape (d,)."""
     return joint_frames(arm, theta)[0][-1, : arm.dim]

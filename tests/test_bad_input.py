@@ -69,3 +69,9 @@ def test_step_function_with_the_wrong_output_shape():
 def test_bad_batch_input(targets, theta0, message):
     with pytest.raises(ValueError, match=message):
         ik.solve_batch(ARM, targets, theta0)
+
+
+@pytest.mark.parametrize("fn", [ik.fk, ik.joint_positions, ik.jacobian, ik.jacobian_autodiff])
+def test_kinematics_name_a_wrong_number_of_angles(fn):
+    with pytest.raises(ValueError, match=r"theta: expected shape \(3,\)"):
+        fn(ARM, np.zeros(2))
