@@ -1,4 +1,10 @@
-"""Many targets at once: the solve loop under jax.vmap, compiled once with jax.jit."""
+"""Many targets at once: the solve loop under jax.vmap, compiled once with jax.jit.
+
+Targets differ in how many iterations they need. A vmapped while-loop would keep every
+lane busy until the slowest target is done, so instead a fixed number of slots run side
+by side and a slot whose target has finished takes the next target from the queue:
+the work is the sum of the iterations, not the batch size times the largest count.
+"""
 import dataclasses
 from functools import partial
 
@@ -8,7 +14,10 @@ import numpy as np
 
 from .pinv import DEFAULT_RCOND
 from .sdls import GAMMA_MAX
-from .solve import DEFAULT_DAMPING, STATUSES, check_problem, resolve_method, run_loop
+from .solve import (DEFAULT_DAMPING, RUNNING, STATUSES, advance, check_problem, initial_state,
+                    resolve_method)
+
+SLOTS = 1024  # targets in flight at once
 
 
 @dataclasses.dataclass(frozen=True)
@@ -27,10 +36,39 @@ class BatchResult:
         return {s: int(np.sum(self.status == s)) for s in STATUSES[1:]}
 
 
-@partial(jax.jit, static_argnames=("method", "task", "max_iter"))
-def _run_batch(method, task, arm, targets, thetas0, settings, max_iter):
-    one = lambda t, q: run_loop(method, task, arm, t, q, settings, max_iter, False)
-    return jax.vmap(one)(targets, thetas0)
+def _select(mask, a, b):
+    """Per slot: a where mask, else b (for every field of a state)."""
+    return jax.tree_util.tree_map(
+        lambda x, y: jnp.where(mask.reshape(mask.shape + (1,) * (x.ndim - 1)), x, y), a, b)
+
+
+@partial(jax.jit, static_argnames=("method", "task", "max_iter", "slots"))
+def _run_queue(method, task, arm, targets, thetas0, settings, max_iter, slots):
+    """Solve every target; `slots` of them in flight, refilled from the queue as they finish."""
+    count = targets.shape[0]
+    step = jax.vmap(lambda t, s: advance(method, task, arm, t, settings, max_iter, s))
+    start = jax.vmap(lambda q: initial_state(q, max_iter, False))
+
+    def load(index):  # fresh states for these targets; an index past the end marks an idle slot
+        state = start(thetas0[jnp.minimum(index, count - 1)])
+        return state._replace(status=jnp.where(index < count, state.status, -1))
+
+    def body(carry):
+        index, state, out, queued = carry
+        running = state.status == RUNNING
+        state = _select(running, step(targets[jnp.minimum(index, count - 1)], state), state)
+        done = running & (state.status != RUNNING)
+        out = jax.tree_util.tree_map(
+            lambda o, x: o.at[jnp.where(done, index, count)].set(x, mode="drop"), out, state)
+        free = state.status != RUNNING
+        new_index = queued + jnp.cumsum(free) - 1
+        index = jnp.where(free, new_index, index)
+        state = _select(free, load(index), state)
+        return index, state, out, queued + jnp.sum(free)
+
+    index = jnp.arange(slots)
+    carry = (index, load(index), start(thetas0), jnp.asarray(slots))
+    return jax.lax.while_loop(lambda c: jnp.any(c[1].status == RUNNING), body, carry)[2]
 
 
 def solve_batch(arm, targets, theta0, method="dls", tol=1e-3, max_iter=1000,
@@ -49,7 +87,8 @@ def solve_batch(arm, targets, theta0, method="dls", tol=1e-3, max_iter=1000,
         weights=weights)
     if theta0.ndim == 1:
         theta0 = jnp.broadcast_to(theta0, (targets.shape[0], theta0.shape[0]))
-    state = _run_batch(method, task, arm, targets, theta0, settings, max_iter)
+    state = _run_queue(method, task, arm, targets, theta0, settings, max_iter,
+                       min(SLOTS, targets.shape[0]))
     return BatchResult(
         theta=np.asarray(state.theta),
         status=np.asarray(STATUSES, dtype=object)[np.asarray(state.status)],

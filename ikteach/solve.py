@@ -121,7 +121,7 @@ class State(NamedTuple):
     trace_error: jax.Array
 
 
-def _advance(method, task, arm, target, settings, max_iter, state):
+def advance(method, task, arm, target, settings, max_iter, state):
     """One pass of the loop described in the module docstring."""
     e = task.error(arm, target, state.theta)
     err = jnp.linalg.norm(e)
@@ -148,7 +148,7 @@ def _advance(method, task, arm, target, settings, max_iter, state):
                  status, trace_theta, trace_error)
 
 
-def _initial_state(theta0, max_iter, record):
+def initial_state(theta0, max_iter, record):
     n = theta0.shape[0]
     rows = max_iter + 1 if record else 0
     trace_theta = jnp.zeros((rows, n)).at[0].set(theta0) if record else jnp.zeros((0, n))
@@ -158,24 +158,30 @@ def _initial_state(theta0, max_iter, record):
 
 def run_loop(method, task, arm, target, theta0, settings, max_iter, record):
     """The loop as a lax.while_loop (traceable: used under jit and vmap)."""
-    body = partial(_advance, method, task, arm, target, settings, max_iter)
+    body = partial(advance, method, task, arm, target, settings, max_iter)
     return jax.lax.while_loop(lambda s: s.status == RUNNING, body,
-                              _initial_state(theta0, max_iter, record))
+                              initial_state(theta0, max_iter, record))
 
 
-_run_jit = jax.jit(run_loop, static_argnames=("method", "task", "max_iter", "record"))
+@partial(jax.jit, static_argnames=("method", "task", "max_iter", "record"))
+def _run_jit(method, task, arm, target, theta0, settings, max_iter, record):
+    """The compiled loop, run as a batch of one so that its arithmetic is the batched
+    arithmetic of solve_batch: the same target gives the same iterates to the last bit."""
+    one = lambda t, q: run_loop(method, task, arm, t, q, settings, max_iter, record)
+    state = jax.vmap(one)(target[None], theta0[None])
+    return jax.tree_util.tree_map(lambda x: x[0], state)
 
 
 def _run_eager(method, task, arm, target, theta0, settings, max_iter, record):
     """The same loop, one Python iteration at a time, for step functions JAX cannot trace."""
-    state = _initial_state(theta0, max_iter, record)
+    state = initial_state(theta0, max_iter, record)
     while int(state.status) == RUNNING:
         try:
-            state = _advance(method, task, arm, target, settings, max_iter, state)
+            state = advance(method, task, arm, target, settings, max_iter, state)
         except StopSolve:  # the step function's own stop rule fired
             err = jnp.linalg.norm(task.error(arm, target, state.theta))
             trace_error = state.trace_error.at[state.i].set(err) if record else state.trace_error
-            status = CONVERGED if err < settings.tol else STALLED  # same order as _advance
+            status = CONVERGED if err < settings.tol else STALLED  # same order as advance
             state = state._replace(error=err, status=jnp.asarray(status), trace_error=trace_error)
     return state
 
