@@ -12,6 +12,7 @@ Jacobian [w_i x (p_e - p_i); w_i] (ik.jacobian(arm, theta, full=True)) drives it
 """
 import dataclasses
 
+import jax
 import jax.numpy as jnp
 
 from ._validate import as_number
@@ -26,6 +27,7 @@ SMALL = 1e-6
 NEAR_PI = -0.9
 
 
+@jax.jit
 def fk_pose(arm, theta):
     """Forward kinematics as a 4x4 homogeneous transform T = [[R, p], [0, 0, 0, 1]]."""
     positions, _, R = joint_frames(arm, theta)
@@ -33,6 +35,7 @@ def fk_pose(arm, theta):
     return jnp.vstack([top, jnp.array([[0.0, 0.0, 0.0, 1.0]])])
 
 
+@jax.jit
 def rotation_exp(omega):
     """Rodrigues' formula for a rotation vector: exp([w]x) = I + sinc(t)[w]x + (1-cos t)/t^2 [w]x^2,
     t = |w|; the two coefficients use their Taylor series near t = 0 (finite gradient at 0)."""
@@ -46,6 +49,7 @@ def rotation_exp(omega):
     return jnp.eye(3) + a * K + b * (K @ K)
 
 
+@jax.jit
 def rotation_log(R):
     """The rotation vector omega = angle * axis of a rotation matrix, angle in [0, pi].
 

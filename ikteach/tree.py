@@ -94,6 +94,7 @@ def ancestors(arm):
     return mask
 
 
+@jax.jit
 def tree_frames(arm, theta):
     """World joint positions (n, 3), world axes (n, 3) and effector positions (m, 3).
 
@@ -101,27 +102,37 @@ def tree_frames(arm, theta):
     p_j = p_parent + R_parent (rest_j - rest_parent),  w_j = R_parent a_j,
     effector k on joint j:  x_k = p_j + R_j (rest_k - rest_j).
     """
-    theta = jnp.asarray(theta)
-    rest = jnp.asarray(arm.positions)
-    R, p, w = [], [], []
-    for j, parent in enumerate(arm.parents):
-        if parent < 0:
-            Rp, pj = jnp.eye(3), rest[j]
-        else:
-            Rp = R[parent]
-            pj = p[parent] + Rp @ (rest[j] - rest[parent])
-        w.append(Rp @ arm.axes[j])
-        p.append(pj)
-        R.append(Rp @ rotation_about(arm.axes[j], theta[j]))
-    x = [p[j] + R[j] @ (arm.effectors[k] - rest[j]) for k, j in enumerate(arm.effector_parents)]
-    return jnp.stack(p), jnp.stack(w), jnp.stack(x)
+    theta = jnp.asarray(theta, dtype=float)
+    rest, axes = jnp.asarray(arm.positions), jnp.asarray(arm.axes)
+    parents = np.asarray(arm.parents)
+    n = len(parents)
+    if theta.shape != (n,):
+        raise ValueError(f"theta: expected shape ({n},), one angle per joint, got shape {theta.shape}")
+
+    def visit(carry, joint):  # joints in order, every parent before its children
+        R_all, p_all = carry
+        j, parent = joint
+        root = parent < 0
+        k = jnp.maximum(parent, 0)
+        Rp = jnp.where(root, jnp.eye(3), R_all[k])
+        pj = jnp.where(root, rest[j], p_all[k] + Rp @ (rest[j] - rest[k]))
+        Rj = Rp @ rotation_about(axes[j], theta[j])
+        return (R_all.at[j].set(Rj), p_all.at[j].set(pj)), Rp @ axes[j]
+
+    (R, p), w = jax.lax.scan(visit, (jnp.zeros((n, 3, 3)), jnp.zeros((n, 3))),
+                             (jnp.arange(n), jnp.asarray(parents)))
+    on = np.asarray(arm.effector_parents)
+    x = p[on] + jnp.einsum("kab,kb->ka", R[on], jnp.asarray(arm.effectors) - rest[on])
+    return p, w, x
 
 
+@jax.jit
 def tree_fk(arm, theta):
     """End-effector positions x_k = F_k(theta): shape (m, 3)."""
     return tree_frames(arm, theta)[2]
 
 
+@jax.jit
 def tree_jacobian(arm, theta):
     """The stacked Jacobian, one block of 3 rows per end effector: shape (3m, n).
 
@@ -133,6 +144,7 @@ def tree_jacobian(arm, theta):
     return jnp.transpose(blocks, (0, 2, 1)).reshape(3 * arm.n_effectors, arm.n_joints)
 
 
+@jax.jit
 def tree_jacobian_autodiff(arm, theta):
     """The stacked Jacobian by jax.jacfwd of the flattened effector positions, for checking."""
     return jax.jacfwd(lambda t: tree_fk(arm, t).reshape(-1))(jnp.asarray(theta, dtype=float))
