@@ -23,7 +23,6 @@ import numpy as np
 
 from .chain import planar_chain
 from .dls import dls_step as _ref_dls
-from .dls import dls_step_normal as _ref_dls_normal
 from .jacobian import jacobian as _ref_jacobian
 from .jt import jt_step as _ref_jt
 from .pinv import pinv_step as _ref_pinv

@@ -1,6 +1,7 @@
 """Forward kinematics: x = F(theta), by walking the chain from base to end effector."""
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 
 def skew(w):
@@ -49,3 +50,9 @@ def joint_positions(arm, theta):
 def fk(arm, theta):
     """End-effector position x = F(theta): shape (d,)."""
     return joint_frames(arm, theta)[0][-1, : arm.dim]
+
+
+def end_path(arm, thetas):
+    """End-effector positions F(theta_k) for each row of thetas (k, n): shape (k, d)."""
+    thetas = jnp.asarray(thetas, dtype=float)
+    return np.asarray(jax.vmap(lambda q: fk(arm, q))(thetas))

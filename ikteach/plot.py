@@ -27,6 +27,7 @@ from matplotlib.ticker import FuncFormatter, NullFormatter
 
 from .chain import reach
 from .jacobian import jacobian
+from . import kinematics
 from .kinematics import joint_positions
 
 METHOD_COLORS = {"jt": "C0", "pinv": "C3", "dls": "C2"}
@@ -105,7 +106,7 @@ def draw_target(ax, target, color="k", label="target"):
 
 def end_path(arm, thetas):
     """End-effector positions (k, 2) along a sequence of joint vectors (k, n)."""
-    return np.array([_xy(arm, q)[-1] for q in np.asarray(thetas, dtype=float)])
+    return kinematics.end_path(arm, thetas)[:, :2]
 
 
 def draw_path(ax, arm, thetas, color="C0", **kw):

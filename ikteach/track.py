@@ -53,7 +53,8 @@ def _track(method, task, arm, targets, theta0, settings, d_max):
         e = task.error(arm, target, theta)
         e = clamp_blocks(e, block or e.shape[0], d_max)
         delta = cap_step(method.delta(task, arm, target, theta, e, settings), settings.max_step)
-        theta = theta + delta
+        new = theta + delta
+        theta = jnp.where(jnp.all(jnp.isfinite(new)), new, theta)  # never NaN: keep the last finite
         e_after = task.error(arm, target, theta)
         err = jnp.sum(jnp.linalg.norm(e_after.reshape(-1, block or e_after.shape[0]), axis=1))
         return theta, (theta, err)

@@ -4,7 +4,6 @@ reachable set's boundary with skimage.measure.find_contours; track a closed path
 from a scikit-image sample image with one update per frame (Buss's moving target).
 """
 import dataclasses
-from functools import partial
 
 import jax
 import jax.numpy as jnp
@@ -12,9 +11,10 @@ import numpy as np
 
 from .batch import solve_batch
 from .jacobian import jacobian
-from .kinematics import fk
-from .limits import cap_step
-from .solve import STATUSES, check_problem, resolve_method
+from ._validate import as_array
+from .kinematics import end_path  # noqa: F401  (ws.end_path, used by the notebook)
+from .solve import STATUSES
+from .track import track as follow
 
 STATUS_COLORS = {"converged": "#55a868", "stalled": "#dd8452", "max_iter": "#c44e52",
                  "diverged": "#222222"}
@@ -206,33 +206,11 @@ class Tracking:
                 "max jitter": float(self.jitter.max())}
 
 
-@partial(jax.jit, static_argnames=("method", "task"))
-def _track(method, task, arm, path, theta0, settings):
-    def frame(theta, target):
-        e = task.error(arm, target, theta)
-        delta = cap_step(method.delta(task, arm, target, theta, e, settings), settings.max_step)
-        new = theta + delta
-        new = jnp.where(jnp.all(jnp.isfinite(new)), new, theta)
-        return new, (new, jnp.linalg.norm(task.error(arm, target, new)))
-
-    return jax.lax.scan(frame, theta0, path)[1]
-
-
-
 def track(arm, path, theta0, method="dls", damping=0.5, rcond=1e-6, clamp=None, max_step=None):
-    """Buss's moving-target protocol: the target moves along path (k, d); each frame takes
-    one step of `method` (the same method objects as ik.solve) from the previous theta."""
+    """Buss's moving-target protocol along a path (k, d): one step of `method` per frame,
+    from the previous theta (ik.track), kept with per-frame jitter for the maps notebook."""
     name = method if isinstance(method, str) else getattr(method, "__name__", "custom")
-    m = resolve_method(method)
-    task, path, theta0, settings, _ = check_problem(
-        arm, path, theta0, tol=1e-3, max_iter=1, damping=damping, rcond=rcond, clamp=clamp,
-        max_step=max_step, stall_tol=0.0, batch=True)
-    if theta0.ndim != 1:
-        raise ValueError(f"theta0: expected one start (n,), got shape {theta0.shape}")
-    thetas, errors = _track(m, task, arm, path, theta0, settings)
-    return Tracking(name, np.asarray(thetas), np.asarray(errors))
-
-
-def end_path(arm, thetas):
-    """End-effector positions F(theta) for each row of thetas."""
-    return np.asarray(jax.vmap(lambda q: fk(arm, q))(jnp.asarray(thetas)))
+    theta0 = as_array(theta0, "theta0", shape=(arm.n_joints,))
+    res = follow(arm, path, theta0, method=method, damping=damping, rcond=rcond, clamp=clamp,
+                 max_step=max_step)
+    return Tracking(name, res.theta[1:], res.error)
