@@ -21,10 +21,12 @@ EPS = 1e-12
 
 
 def _toward(a, b, d):
-    """The point at distance d from a in the direction of b (a itself when b = a)."""
+    """The point at distance d from a in the direction of b (along +x when b = a, so that
+    the link keeps its length even when two points coincide)."""
     v = b - a
     n = jnp.linalg.norm(v)
-    return a + d * v / jnp.where(n > EPS, n, 1.0) * (n > EPS)
+    unit = jnp.where(n > EPS, v / jnp.where(n > EPS, n, 1.0), jnp.array([1.0, 0.0, 0.0]))
+    return a + d * unit
 
 
 def fabrik_forward(points, lengths, target):

@@ -76,3 +76,12 @@ def test_ccd_and_fabrik_refuse_trees():
     for method in ("ccd", "fabrik"):
         with pytest.raises(ValueError, match="method"):
             ik.solve(Y, np.zeros((2, 3)), np.zeros(7), method=method)
+
+
+def test_fabrik_pass_keeps_link_lengths_when_points_coincide():
+    # straight arm, target on the base: the forward pass lands a joint on the next one
+    arm = ik.planar_chain([1.0, 1.0, 1.0])
+    points = np.asarray(ik.joint_frames(arm, np.zeros(3))[0])
+    new = np.asarray(fabrik_pass(points, np.ones(3), np.zeros(3)))
+    np.testing.assert_allclose(np.linalg.norm(np.diff(new, axis=0), axis=1), [1.0, 1.0, 1.0])
+    np.testing.assert_allclose(new[0], points[0])
