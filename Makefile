@@ -30,5 +30,10 @@ exercises: $(STAMP)
 clean:
 	rm -rf $(VENV) .pytest_cache .hypothesis
 
-bench: $(STAMP)
-	$(PY) benchmarks/sweep.py
+# Benchmarks print tables (never part of make test). The peer libraries of the bench extra
+# go into their own venv, so that they never change what the tests run against.
+BENCH_VENV ?= .venv-bench
+bench:
+	@test -x $(BENCH_VENV)/bin/python || $(PYTHON) -m venv $(BENCH_VENV)
+	$(BENCH_VENV)/bin/python -m pip install --quiet -e ".[dev,bench]"
+	@for b in benchmarks/*.py; do echo "== $$b"; $(BENCH_VENV)/bin/python $$b || exit 1; done
