@@ -222,14 +222,7 @@ def animate_solve(arm, result, target, max_frames=MAX_FRAMES, title=None, spacin
         heading.set_text(f"{title}\n{label}" if title else label)
         return (*arm_artists, trail, done, now, heading)
 
-    frame(len(ks) - 1)  # lay out with the longest title
-    fig.tight_layout()
-
-    anim = FuncAnimation(fig, frame, frames=len(ks), interval=250, blit=False, repeat=True)
-    anim.iterations = ks
-    anim.still = len(ks) - 1
-    plt.close(fig)
-    return anim
+    return _animation(fig, frame, ks, interval=250)
 
 
 def animate_race(arm, results, target, max_frames=MAX_FRAMES, spacing="log", figsize=None):
@@ -285,9 +278,15 @@ def animate_race(arm, results, target, max_frames=MAX_FRAMES, spacing="log", fig
             drawn += [*art, trail, head, dot]
         return drawn
 
+    return _animation(fig, frame, ks, interval=300)
+
+
+def _animation(fig, frame, ks, interval):
+    """Lay the figure out at its last frame (the longest titles), wrap it in a FuncAnimation
+    that remembers the iterations it shows and its still frame, and close the figure."""
     frame(len(ks) - 1)
     fig.tight_layout()
-    anim = FuncAnimation(fig, frame, frames=len(ks), interval=300, blit=False, repeat=True)
+    anim = FuncAnimation(fig, frame, frames=len(ks), interval=interval, blit=False, repeat=True)
     anim.iterations = ks
     anim.still = len(ks) - 1
     plt.close(fig)
