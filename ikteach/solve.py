@@ -31,6 +31,7 @@ STATUSES = ("running", "converged", "stalled", "max_iter", "diverged")
 RUNNING, CONVERGED, STALLED, MAX_ITER, DIVERGED = range(5)
 
 DEFAULT_DAMPING = 0.5
+STALL_FRACTION = 1e-5  # default stall_tol = STALL_FRACTION * total link length
 
 
 class StopSolve(Exception):
@@ -38,7 +39,6 @@ class StopSolve(Exception):
 
     The loop keeps the current theta; the step that raised is not taken.
     """
-STALL_FRACTION = 1e-5  # default stall_tol = STALL_FRACTION * total link length
 
 
 class Settings(NamedTuple):
