@@ -15,7 +15,7 @@ import numpy as np
 from .pinv import DEFAULT_RCOND
 from .sdls import GAMMA_MAX
 from .solve import (DEFAULT_DAMPING, RUNNING, STATUSES, advance, check_problem, initial_state,
-                    resolve_method)
+                    resolve_method, status_counts)
 
 SLOTS = 1024  # targets in flight at once
 
@@ -33,7 +33,7 @@ class BatchResult:
 
     def counts(self):
         """How many targets ended in each status."""
-        return {s: int(np.sum(self.status == s)) for s in STATUSES[1:]}
+        return status_counts(self.status)
 
 
 def _select(mask, a, b):

@@ -18,7 +18,6 @@ Planar arms are drawn in their plane; spatial chains are drawn projected on x-y.
 """
 import io
 
-import jax
 import jax.numpy as jnp
 import matplotlib.pyplot as plt
 import numpy as np
@@ -35,11 +34,8 @@ MAX_FRAMES = 16
 TRAIL = 30  # end-effector positions kept behind each arm in a race
 
 
-_joint_positions = jax.jit(joint_positions)  # compiled once per arm shape: fast redraws
-
-
 def _xy(arm, theta):
-    return np.asarray(_joint_positions(arm, jnp.asarray(theta, dtype=float)))[:, :2]
+    return np.asarray(joint_positions(arm, jnp.asarray(theta, dtype=float)))[:, :2]
 
 
 def color_for(name, k=0):

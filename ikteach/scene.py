@@ -9,7 +9,7 @@ import io
 
 import numpy as np
 
-from .kinematics import joint_frames
+from .kinematics import end_path, joint_frames
 from .chain import reach
 
 COLORS = {"link": "#4c72b0", "joint": "#dd8452", "base": "#555555", "trail": "#c44e52",
@@ -155,7 +155,7 @@ def solve_gif(arm, trace_theta, path, target=None, frames_max=30, fps=8, window_
     pv = _pv()
     thetas = np.asarray(trace_theta, dtype=float)
     idx = np.unique(np.linspace(0, len(thetas) - 1, min(frames_max, len(thetas))).round().astype(int))
-    ends = np.array([frames(arm, q)[0][-1] for q in thetas])
+    ends = end_path(arm, thetas)
     p = pv.Plotter(window_size=list(window_size), off_screen=True)
     p.open_gif(str(path), fps=fps)
     for k in idx:

@@ -41,6 +41,11 @@ class StopSolve(Exception):
     """
 
 
+def status_counts(status):
+    """How many entries of an array of status names ended in each status."""
+    return {s: int(np.sum(np.asarray(status) == s)) for s in STATUSES[1:]}
+
+
 class Settings(NamedTuple):
     """Numbers the loop reads (traced, so changing them does not recompile)."""
     tol: float

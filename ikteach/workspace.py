@@ -13,7 +13,7 @@ from .batch import solve_batch
 from .jacobian import jacobian
 from ._validate import as_array
 from .kinematics import end_path  # noqa: F401  (ws.end_path, used by the notebook)
-from .solve import STATUSES
+from .solve import status_counts
 from .track import track as follow
 
 STATUS_COLORS = {"converged": "#55a868", "stalled": "#dd8452", "max_iter": "#c44e52",
@@ -68,14 +68,17 @@ class SweepMap:
     error: np.ndarray        # (n, n)
 
     def counts(self):
-        return {s: int(np.sum(self.status == s)) for s in STATUSES[1:]}
+        return status_counts(self.status)
+
+
+def _method_name(method):
+    return method if isinstance(method, str) else getattr(method, "__name__", "custom")
 
 
 def sweep(arm, grid, theta0, method="dls", **kwargs):
     """ik.solve_batch over every grid target from the same theta0; results as images."""
     res = solve_batch(arm, grid.points, theta0, method=method, **kwargs)
-    name = method if isinstance(method, str) else getattr(method, "__name__", "custom")
-    return SweepMap(name, grid.image(res.iterations), grid.image(res.status),
+    return SweepMap(_method_name(method), grid.image(res.iterations), grid.image(res.status),
                     grid.image(res.theta), grid.image(res.error))
 
 
@@ -209,8 +212,7 @@ class Tracking:
 def track(arm, path, theta0, method="dls", damping=0.5, rcond=1e-6, clamp=None, max_step=None):
     """Buss's moving-target protocol along a path (k, d): one step of `method` per frame,
     from the previous theta (ik.track), kept with per-frame jitter for the maps notebook."""
-    name = method if isinstance(method, str) else getattr(method, "__name__", "custom")
     theta0 = as_array(theta0, "theta0", shape=(arm.n_joints,))
     res = follow(arm, path, theta0, method=method, damping=damping, rcond=rcond, clamp=clamp,
                  max_step=max_step)
-    return Tracking(name, res.theta[1:], res.error)
+    return Tracking(_method_name(method), res.theta[1:], res.error)
