@@ -159,14 +159,15 @@ def _interrupt(client):
 
 
 def _read_grade(cell, token):
-    for out in cell.get("outputs", []):
-        if out.get("output_type") == "stream" and out.get("name") == "stdout":
-            for line in out.get("text", "").splitlines():
-                if line.startswith(token):
-                    try:
-                        return json.loads(line[len(token):])
-                    except ValueError:
-                        return None
+    """The grade the grading cell printed after `token` (stdout may arrive in several pieces)."""
+    text = "".join(out.get("text", "") for out in cell.get("outputs", [])
+                   if out.get("output_type") == "stream" and out.get("name") == "stdout")
+    for line in text.splitlines():
+        if line.startswith(token):
+            try:
+                return json.loads(line[len(token):])
+            except ValueError:
+                return None
     return None
 
 

@@ -77,7 +77,8 @@ def test_wrong_submissions_get_partial_marks_and_the_right_feedback(graded, stud
 def test_a_hostile_submission_costs_only_its_own_marks(graded):
     """It deletes every file in its working directory, then never returns."""
     rows, feedback, before = graded
-    assert scores(rows["hostile"])[1] == 10.0  # its function is right; the loop is cut off
+    # its function is right; the loop is cut off
+    assert scores(rows["hostile"])[1] == 10.0, feedback["hostile"]
     assert "did not finish within the notebook's time limit (40 s)" in feedback["hostile"]
     for path, content in before.items():  # the submissions themselves are untouched
         assert path.read_bytes() == content
@@ -92,3 +93,10 @@ def test_exercise_number_from_metadata_or_name():
 def test_missing_submissions_dir_is_a_clear_error(tmp_path):
     with pytest.raises(ValueError, match="SUBMISSIONS_DIR"):
         grade.grade_all(tmp_path / "nope", tmp_path / "g.csv")
+
+
+def test_the_grade_line_is_read_even_when_stdout_arrives_in_pieces():
+    token = "IKTEACH-GRADE-abc:"
+    cell = {"outputs": [{"output_type": "stream", "name": "stdout", "text": "checks...\n" + token + '{"sco'},
+                        {"output_type": "stream", "name": "stdout", "text": 're": 7}\n'}]}
+    assert grade._read_grade(cell, token) == {"score": 7}
