@@ -29,6 +29,7 @@ from .pose import fk_pose, rotation_log, rotation_exp, pose_errors, make_pose, P
 from .robots import ur5, iiwa14  # noqa: E402
 from . import robots  # noqa: E402
 from . import scene, workspace  # noqa: E402
+from . import bvh, skeleton, footplant  # noqa: E402  (characters: BVH clips, rigs, foot planting)
 
 __all__ = [
     "Chain", "planar_chain", "serial_chain", "reach",
@@ -44,5 +45,6 @@ __all__ = [
     "track", "TrackResult", "buss_trees", "tree_plot", "plot", "demo",
     "fk_pose", "rotation_log", "rotation_exp", "pose_errors", "make_pose", "PoseTask",
     "ur5", "iiwa14", "robots", "scene", "workspace",
+    "bvh", "skeleton", "footplant",
 ]
 __version__ = "0.1.0"
