@@ -6,21 +6,17 @@ clean a clip with IK so that planted feet stay put.
 2. skate:     horizontal foot travel summed over consecutive contact frames, sum |dx_xz|.
 3. targets:   in each contact interval the foot aims at one point, the mean of where it was;
    between contacts the correction (target - foot) is interpolated, so the targets glide.
-4. plant:     frame by frame, the solve loop (DLS) moves only the leg joints to put the feet
-   on their targets, warm-started with the previous frame's correction.
+4. clean:     frame by frame, the solve loop (DLS) moves only the hips and knees to put the
+   feet on their targets (ik.clip_ik.solve_clip), warm-started from the previous frame.
 """
 import dataclasses
-from functools import partial
 
-import jax
-import jax.numpy as jnp
 import numpy as np
 
-from ._validate import as_array, as_count, as_number
+from ._validate import as_array, as_number
 from .bvh import Motion, Skeleton
+from .clip_ik import ClipResult, solve_clip
 from .skeleton import rest_positions
-from .solve import METHODS, Settings, run_loop
-from .tree import TreeTask, tree_jacobian, tree_size
 
 UP = 1  # BVH's Y axis points up
 
@@ -86,8 +82,10 @@ def plant_targets(positions, contact):
 
 def retarget(skeleton, motion, scales):
     """A copy of the clip on a skeleton whose bones are scaled: scales {joint: factor} scales
-    the offset from that joint's parent. The root's path is scaled by the ratio of hip heights
-    (root above the lowest rest point), the naive retarget that makes feet skate."""
+    the offset from that joint's parent. The naive retarget: same joint angles, the root's
+    height scaled by the ratio of hip heights (root above the lowest rest point), its path
+    along the ground kept. Longer legs then take longer strides than the body travels: the
+    planted feet skate."""
     if not isinstance(skeleton, Skeleton):
         raise ValueError(f"skeleton: expected an ik.bvh.Skeleton, got {type(skeleton).__name__}")
     if not isinstance(scales, dict) or not scales:
@@ -103,63 +101,9 @@ def retarget(skeleton, motion, scales):
 
     frames = np.array(motion.frames)
     cols = skeleton.columns(skeleton.names[0])
-    position_cols = [cols[c] for c in ("Xposition", "Yposition", "Zposition") if c in cols]
-    frames[:, position_cols] *= hip_height(new) / hip_height(skeleton)
+    if "Yposition" in cols:
+        frames[:, cols["Yposition"]] *= hip_height(new) / hip_height(skeleton)
     return new, Motion(frames, motion.frame_time)
-
-
-@dataclasses.dataclass(frozen=True)
-class MaskedTreeTask(TreeTask):
-    """A tree task in which only some joints may turn: J's other columns are zero."""
-    mask: tuple = ()
-
-    def jacobian(self, arm, theta):
-        return tree_jacobian(arm, theta) * jnp.asarray(self.mask)
-
-
-@partial(jax.jit, static_argnames=("task", "max_iter"))
-def _plant(task, arm, targets, theta, settings, max_iter):
-    method = METHODS["dls"]
-
-    def frame(correction, inputs):
-        target, clip = inputs
-        state = run_loop(method, task, arm, target, clip + correction, settings, max_iter, False)
-        return state.theta - clip, (state.theta, state.error, state.i)
-
-    _, out = jax.lax.scan(frame, jnp.zeros_like(theta[0]), (targets, theta))
-    return out
-
-
-@dataclasses.dataclass(frozen=True)
-class PlantResult:
-    """theta (F, n) cleaned angles; error (F,) |e| left per frame; iterations (F,)."""
-    theta: np.ndarray
-    error: np.ndarray
-    iterations: np.ndarray
-
-
-def plant(rig, root, theta, targets, active, tol=1e-3, max_iter=50, damping=1.0):
-    """Solve every frame for the rig's end effectors to reach targets (F, m, 3) (world
-    coordinates), turning only the `active` joints (indices of revolute joints), each frame
-    warm-started from the clip plus the previous frame's correction."""
-    theta = as_array(theta, "theta", shape=(None, rig.n_joints))
-    count = len(theta)
-    root = as_array(root, "root", shape=(count, 3))
-    targets = as_array(targets, "targets", shape=(count, rig.tree.n_effectors, 3))
-    mask = np.zeros(rig.n_joints)
-    try:
-        mask[np.asarray(active, dtype=int)] = 1.0
-    except (IndexError, ValueError, TypeError):
-        raise ValueError(f"active: expected indices of revolute joints below {rig.n_joints}, "
-                         f"got {active!r:.80}") from None
-    settings = Settings(tol=as_number(tol, "tol", minimum=0, strict=True),
-                        damping=as_number(damping, "damping", minimum=0), rcond=0.0, clamp=np.inf,
-                        max_step=np.inf, stall_tol=1e-7 * tree_size(rig.tree))
-    task = MaskedTreeTask(mask=tuple(mask.tolist()))
-    local = targets - root[:, None, :]          # the tree is built around the root
-    thetas, errors, iterations = _plant(task, rig.tree, jnp.asarray(local), jnp.asarray(theta),
-                                        settings, as_count(max_iter, "max_iter"))
-    return PlantResult(np.asarray(thetas), np.asarray(errors), np.asarray(iterations))
 
 
 def largest_step(theta):
@@ -189,7 +133,7 @@ class Cleanup:
     feet_before: np.ndarray
     feet_after: np.ndarray
     targets: np.ndarray
-    result: PlantResult
+    result: ClipResult
 
     @property
     def skate_before(self):
@@ -215,6 +159,6 @@ def clean_clip(skeleton, motion, scales, feet=("LeftFoot", "RightFoot"), height=
     before = world_points(rig, root, theta)
     targets = plant_targets(before, contact)
     active = sum((leg_joints(rig, f) for f in feet), [])
-    result = plant(rig, root, theta, targets, active, **solve_options)
+    result = solve_clip(rig, root, theta, targets, active, **solve_options)
     return Cleanup(rig, root, contact, theta, result.theta, before,
                    world_points(rig, root, result.theta), targets, result)

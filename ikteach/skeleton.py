@@ -53,8 +53,11 @@ class Rig:
         sk = self.skeleton
         where = {name: k for k, name in enumerate(self.points)}
         pairs = []
-        for k, name in enumerate(self.points):  # an end site hangs on its joint "<joint>_end"
-            j = sk.parents[sk.index(name)] if name in sk.names else sk.index(name[:-4])
+        for k, name in enumerate(self.points):  # end sites and offset points hang on their joint
+            if isinstance(name, tuple):
+                j = sk.index(name[0])
+            else:
+                j = sk.parents[sk.index(name)] if name in sk.names else sk.index(name[:-4])
             while j >= 0 and sk.names[j] not in where:
                 j = sk.parents[j]
             if j >= 0:
@@ -68,6 +71,20 @@ def _end_index(sk, name):
     if not ends:
         raise ValueError(f"points: joint {name[:-4]!r} has no end site, so {name!r} does not exist")
     return ends[0]
+
+
+def _point(skeleton, joints, ends, point):
+    """(joint that carries the point, its rest position) for a point name (see rig)."""
+    if isinstance(point, tuple) and len(point) == 2 and isinstance(point[0], str):
+        j = skeleton.index(point[0])
+        return j, joints[j] + as_array(point[1], f"points: offset of {point[0]!r}", shape=(3,))
+    if not isinstance(point, str):
+        raise ValueError(f"points: expected joint names or (joint, offset) pairs, got {point!r:.80}")
+    if point.endswith("_end") and point not in skeleton.names:
+        k = _end_index(skeleton, point)
+        return skeleton.end_parents[k], ends[k]
+    j = skeleton.index(point)
+    return j, joints[j]
 
 
 def rest_positions(skeleton):
@@ -87,13 +104,14 @@ def all_points(skeleton):
 def rig(skeleton, points=None):
     """The IK tree of a skeleton, with end effectors at the named points (default: all_points).
 
-    points: joint names (effector at the joint) or "<joint>_end" (at its end site).
+    points: joint names (effector at the joint), "<joint>_end" (at its end site) or
+            (joint, offset) pairs (a point fixed to the joint, offset in the rest pose, e.g. the eyes).
     """
     if not isinstance(skeleton, Skeleton):
         raise ValueError(f"skeleton: expected an ik.bvh.Skeleton, got {type(skeleton).__name__}")
     points = all_points(skeleton) if points is None else tuple(points)
-    if not points or not all(isinstance(p, str) for p in points):
-        raise ValueError(f"points: expected a non-empty list of joint names, got {points!r:.80}")
+    if not points:
+        raise ValueError("points: expected a non-empty list of joint names, got none")
     root_cols = skeleton.columns(skeleton.names[0])
     root_columns = tuple(root_cols[c] for c in POSITIONS) if all(c in root_cols for c in POSITIONS) else None
     joints, ends = rest_positions(skeleton)
@@ -121,12 +139,7 @@ def rig(skeleton, points=None):
         raise ValueError("skeleton: expected rotation channels, got none")
     effectors, effector_parents = [], []
     for name in points:
-        if name.endswith("_end") and name not in skeleton.names:
-            k = _end_index(skeleton, name)
-            j, at = skeleton.end_parents[k], ends[k]
-        else:
-            j = skeleton.index(name)
-            at = joints[j]
+        j, at = _point(skeleton, joints, ends, name)
         effectors.append(at)
         effector_parents.append(max(last[j], 0))
     arm = tree(positions, axes, parents, effectors, effector_parents)

@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
 
-from ikteach import bvh, footplant, skeleton, walk
+from ikteach import bvh, clip_ik, footplant, skeleton, walk
 
-LONG_THIGHS = {"LeftLeg": 1.25, "RightLeg": 1.25, "LeftFoot": 0.9, "RightFoot": 0.9}
+LONG_LEGS = {"LeftLeg": 1.2, "RightLeg": 1.2, "LeftFoot": 1.1, "RightFoot": 1.1}  # thighs, shins
 FEET = ["LeftFoot", "RightFoot"]
 
 
@@ -14,7 +14,7 @@ def clip():
 
 @pytest.fixture(scope="module")
 def cleanup(clip):
-    return footplant.clean_clip(*clip, LONG_THIGHS)
+    return footplant.clean_clip(*clip, LONG_LEGS)
 
 
 def _feet(sk, motion):
@@ -44,7 +44,7 @@ def test_the_original_clip_does_not_skate(clip):
 
 def test_retargeting_makes_the_feet_skate_and_planting_removes_95_percent(cleanup):
     before, after = cleanup.skate_before, cleanup.skate_after
-    assert np.all(before > 10.0)                  # cm of sliding per foot
+    assert np.all(before > 30.0)                  # cm of sliding per foot
     assert np.all(after <= 0.05 * before)
     assert cleanup.feet_before.shape == cleanup.feet_after.shape == (150, 2, 3)
 
@@ -96,8 +96,8 @@ def test_bad_input_names_the_parameter(clip, cleanup):
         footplant.retarget(sk, motion, {"Tail": 2})
     rig, root = cleanup.rig, cleanup.root
     with pytest.raises(ValueError, match="^targets: expected shape"):
-        footplant.plant(rig, root, cleanup.theta_before, cleanup.targets[:, :1], [0])
+        clip_ik.solve_clip(rig, root, cleanup.theta_before, cleanup.targets[:, :1], [0])
     with pytest.raises(ValueError, match="^active: expected indices"):
-        footplant.plant(rig, root, cleanup.theta_before, cleanup.targets, [rig.n_joints])
+        clip_ik.solve_clip(rig, root, cleanup.theta_before, cleanup.targets, [rig.n_joints])
     with pytest.raises(ValueError, match="^damping:"):
-        footplant.plant(rig, root, cleanup.theta_before, cleanup.targets, [0], damping=-1)
+        clip_ik.solve_clip(rig, root, cleanup.theta_before, cleanup.targets, [0], damping=-1)
