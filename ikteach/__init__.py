@@ -29,7 +29,8 @@ from .pose import fk_pose, rotation_log, rotation_exp, pose_errors, make_pose, P
 from .robots import ur5, iiwa14  # noqa: E402
 from . import robots  # noqa: E402
 from . import scene, workspace  # noqa: E402
-from . import bvh, skeleton, footplant  # noqa: E402  (characters: BVH clips, rigs, foot planting)
+from . import bvh, skeleton, clip_ik, footplant, look_at  # noqa: E402  (characters: BVH, rigs, foot planting)
+from . import character_plot, character_scene  # noqa: E402
 
 __all__ = [
     "Chain", "planar_chain", "serial_chain", "reach",
@@ -45,6 +46,6 @@ __all__ = [
     "track", "TrackResult", "buss_trees", "tree_plot", "plot", "demo",
     "fk_pose", "rotation_log", "rotation_exp", "pose_errors", "make_pose", "PoseTask",
     "ur5", "iiwa14", "robots", "scene", "workspace",
-    "bvh", "skeleton", "footplant",
+    "bvh", "skeleton", "clip_ik", "footplant", "look_at", "character_plot", "character_scene",
 ]
 __version__ = "0.1.0"

@@ -33,7 +33,7 @@ def draw_skeleton(ax, rig, points, view="side", color=None, alpha=1.0, label=Non
                      label=label if k == 0 else None)[0]
              for k, (s, c) in enumerate(zip(stick_segments(rig, points), colors))]
     dots = ax.plot(np.asarray(points)[:, i], np.asarray(points)[:, j], "o", color="k", ms=2.5, alpha=alpha)[0]
-    ax.set_aspect("equal")
+    ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("xyz"[i] + " (cm)")
     ax.set_ylabel("xyz"[j] + " (cm)")
     return lines, dots

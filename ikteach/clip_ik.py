@@ -48,13 +48,14 @@ class ClipResult:
     status: np.ndarray
 
 
-def solve_clip(rig, root, theta, targets, active, tol=1e-3, max_iter=50, damping=1.0):
+def solve_clip(rig, root, theta, targets, active, tol=1e-3, max_iter=50, damping=1.0, clamp=None):
     """Solve every frame for the rig's end effectors to reach targets (F, m, 3) (world
     coordinates), turning only the `active` joints (indices of revolute joints), each frame
     warm-started from the clip plus the previous frame's correction.
 
     Every frame runs the module's solve loop (DLS, stop rules as in ik.solve); the frames
-    run in one compiled lax.scan. Returns a ClipResult."""
+    run in one compiled lax.scan; clamp is Buss's D_max on |e| (None: no clamp), which keeps
+    a far target from asking for one huge step. Returns a ClipResult."""
     theta = as_array(theta, "theta", shape=(None, rig.n_joints))
     count = len(theta)
     root = as_array(root, "root", shape=(count, 3))
@@ -67,7 +68,8 @@ def solve_clip(rig, root, theta, targets, active, tol=1e-3, max_iter=50, damping
                          f"got {active!r:.80}")
     mask[index] = 1.0
     settings = Settings(tol=as_number(tol, "tol", minimum=0, strict=True),
-                        damping=as_number(damping, "damping", minimum=0), rcond=0.0, clamp=np.inf,
+                        damping=as_number(damping, "damping", minimum=0), rcond=0.0,
+                        clamp=np.inf if clamp is None else as_number(clamp, "clamp", minimum=0, strict=True),
                         max_step=np.inf, stall_tol=1e-7 * tree_size(rig.tree))
     task = MaskedTreeTask(mask=tuple(mask.tolist()))
     local = targets - root[:, None, :]          # the tree is built around the root
