@@ -52,6 +52,13 @@ class Skeleton:
         start = sum(len(c) for c in self.channels[:j])
         return {c: start + i for i, c in enumerate(self.channels[j])}
 
+    def rig(self, points=None):
+        """The skeleton as an IK tree (ik.skeleton.rig): rig.tree is an ik.Tree with end effectors
+        at the named points (default: every joint and end site)."""
+        from .skeleton import rig
+
+        return rig(self, points)
+
     def __repr__(self):
         return f"Skeleton({len(self.names)} joints, {len(self.end_parents)} end sites, {self.n_channels} channels)"
 

@@ -117,7 +117,8 @@ def test_shipped_walk_is_what_the_generator_makes(clip):
 def test_a_ball_joint_is_three_revolute_axes_in_channel_order(tmp_path):
     (tmp_path / "odd.bvh").write_text(ODD)
     sk, _ = bvh.load(tmp_path / "odd.bvh")
-    rig = skeleton.rig(sk)
+    rig = sk.rig()
+    assert isinstance(rig.tree, ik.Tree) and rig.tree.n_joints == 3 + 3 + 2
     np.testing.assert_allclose(rig.tree.axes[:8], [[1, 0, 0], [0, 1, 0], [0, 0, 1],   # pelvis XYZ
                                                    [0, 1, 0], [0, 0, 1], [1, 0, 0],   # thigh YZX
                                                    [1, 0, 0], [0, 0, 1]])             # shin XZ
