@@ -13,6 +13,7 @@ from .jt import jt_step, optimal_alpha  # noqa: E402
 from .pinv import pinv_step  # noqa: E402
 from .dls import dls_step, dls_step_normal  # noqa: E402
 from .limits import clamp_error, cap_step  # noqa: E402
+from .priority import priority_step, multilevel_step, damped_pinv, null_projector  # noqa: E402
 from .solve import solve, Result, Trace, STATUSES, METHODS  # noqa: E402
 from .solve import StopSolve  # noqa: E402
 from .batch import solve_batch, BatchResult  # noqa: E402
@@ -38,6 +39,7 @@ __all__ = [
     "jacobian", "jacobian_autodiff", "jacobian_fd",
     "jt_step", "optimal_alpha", "pinv_step", "dls_step", "dls_step_normal",
     "clamp_error", "cap_step",
+    "priority_step", "multilevel_step", "damped_pinv", "null_projector",
     "solve", "Result", "Trace", "STATUSES", "METHODS",
     "solve_batch", "BatchResult", "notebook",
     "StopSolve", "check",
