@@ -99,3 +99,24 @@ def test_bad_input_names_the_parameter(clip):
         clip_ik.solve_clip(rig, root[None], theta[None], np.zeros((1, 5, 3)), [0], clamp=0)
     with pytest.raises(ValueError, match="^points: expected joint names or"):
         skeleton.rig(sk, [3])
+
+
+def test_feet_first_priorities_keep_the_feet_when_the_hand_cannot_reach(clip):
+    """Out of reach, stacked DLS lets the feet slide; with the feet as level 0 they stay."""
+    import ikteach as ik
+
+    sk, rig, root, theta = clip
+    active = sum((rig.revolutes(n, c) for n, c in MAY_TURN.items()), [])
+    lower, upper = theta.copy(), theta.copy()
+    lower[active], upper[active] = -np.inf, np.inf            # the other joints are pinned
+    start = skeleton.world_points(rig, root, theta)[0]
+    far = start.copy()
+    far[4] = root + [-30.0, -40.0, 200.0]
+    options = dict(tol=1e-2, damping=5.0, clamp=2.0, max_iter=500, joint_limits=(lower, upper))
+    slid = {}
+    for name, levels in [("stacked", None), ("feet first", [0, 0, 0, 0, 1])]:
+        res = ik.solve(rig.tree, far - root, theta, levels=levels, **options)
+        p = skeleton.world_points(rig, root, res.theta)[0]
+        slid[name] = np.linalg.norm(p[:4] - start[:4], axis=1).max()
+        assert np.linalg.norm(p[4] - far[4]) < np.linalg.norm(start[4] - far[4]) - 20  # reached out
+    assert slid["stacked"] > 0.1 and slid["feet first"] < 1e-3
