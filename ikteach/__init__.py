@@ -13,6 +13,7 @@ from .jt import jt_step, optimal_alpha  # noqa: E402
 from .pinv import pinv_step  # noqa: E402
 from .dls import dls_step, dls_step_normal  # noqa: E402
 from .limits import clamp_error, cap_step  # noqa: E402
+from .priority import priority_step, multilevel_step, damped_pinv, null_projector  # noqa: E402
 from .solve import solve, Result, Trace, STATUSES, METHODS  # noqa: E402
 from .solve import StopSolve  # noqa: E402
 from .batch import solve_batch, BatchResult  # noqa: E402
@@ -29,6 +30,8 @@ from .pose import fk_pose, rotation_log, rotation_exp, pose_errors, make_pose, P
 from .robots import ur5, iiwa14  # noqa: E402
 from . import robots  # noqa: E402
 from . import scene, workspace  # noqa: E402
+from . import bvh, skeleton, clip_ik, footplant, look_at  # noqa: E402  (characters: BVH, rigs, foot planting)
+from . import character_plot, character_scene  # noqa: E402
 
 __all__ = [
     "Chain", "planar_chain", "serial_chain", "reach",
@@ -36,6 +39,7 @@ __all__ = [
     "jacobian", "jacobian_autodiff", "jacobian_fd",
     "jt_step", "optimal_alpha", "pinv_step", "dls_step", "dls_step_normal",
     "clamp_error", "cap_step",
+    "priority_step", "multilevel_step", "damped_pinv", "null_projector",
     "solve", "Result", "Trace", "STATUSES", "METHODS",
     "solve_batch", "BatchResult", "notebook",
     "StopSolve", "check",
@@ -44,5 +48,6 @@ __all__ = [
     "track", "TrackResult", "buss_trees", "tree_plot", "plot", "demo",
     "fk_pose", "rotation_log", "rotation_exp", "pose_errors", "make_pose", "PoseTask",
     "ur5", "iiwa14", "robots", "scene", "workspace",
+    "bvh", "skeleton", "clip_ik", "footplant", "look_at", "character_plot", "character_scene",
 ]
 __version__ = "0.1.0"

@@ -23,6 +23,8 @@ from .dls import dls_step
 from .fabrik import FABRIKMethod
 from .sdls import GAMMA_MAX, SDLSMethod
 from .jt import jt_step
+from .levels import DEFAULT_REST_GAIN, with_priorities
+from .joint_limits import with_limits
 from .limits import cap_step, clamp_error
 from .pinv import DEFAULT_RCOND, pinv_step
 from .tasks import task_for
@@ -55,6 +57,10 @@ class Settings(NamedTuple):
     max_step: float   # per-joint cap in radians; inf for none
     stall_tol: float  # 0 disables the stall stop
     gamma_max: float = np.pi / 4  # SDLS: largest joint turn per step (Buss & Kim 2005)
+    lower: object = -np.inf  # joint limits, per joint (ikteach/joint_limits.py)
+    upper: object = np.inf
+    rest_pose: object = 0.0  # the rest-pose level of a prioritised solve (ikteach/levels.py)
+    rest_gain: float = 0.0
 
 
 def _jt(J, e, s):
@@ -140,7 +146,7 @@ def advance(method, task, arm, target, settings, max_iter, state):
         raise ValueError(f"method: the step function returned shape {delta.shape}, "
                          f"expected {state.theta.shape} (one entry per joint)")
     delta = cap_step(delta.astype(state.theta.dtype), settings.max_step)
-    new_theta = state.theta + delta
+    new_theta = jnp.clip(state.theta + delta, settings.lower, settings.upper)  # joint limits
     finite = jnp.all(jnp.isfinite(new_theta))
     status = jnp.where((status == RUNNING) & ~finite, DIVERGED, status)
     take = status == RUNNING
@@ -231,6 +237,16 @@ def resolve_method(method):
                      f"step(J, e) -> delta_theta, got {method!r:.80}")
 
 
+def with_extras(method, task, arm, target, theta0, settings, levels, rest_pose, rest_gain,
+                joint_limits, limit_mode, batch=False):
+    """Priority levels and joint limits, when asked for, wrapped around the method.
+    With batch=True, target holds one target per row and theta0 may too."""
+    one = (target[0], theta0.reshape(-1, arm.n_joints)[0]) if batch else (target, theta0)
+    method, settings = with_priorities(method, task, arm, *one, settings, levels, rest_pose,
+                                       rest_gain, is_default=method is METHODS["dls"])
+    return with_limits(method, settings, theta0, joint_limits, limit_mode, arm.n_joints)
+
+
 def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, max_step,
                   stall_tol, gamma_max=GAMMA_MAX, batch=False,
                   weights=None):
@@ -271,7 +287,8 @@ def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, 
 
 def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DEFAULT_DAMPING,
           rcond=DEFAULT_RCOND, clamp=None, max_step=None, stall_tol=None, gamma_max=GAMMA_MAX,
-          weights=None):
+          weights=None, joint_limits=None, limit_mode=None, levels=None, rest_pose=None,
+          rest_gain=DEFAULT_REST_GAIN):
     """Solve F(theta) = target from theta0 by repeated steps of `method`.
 
     method    "jt", "pinv", "dls", "sdls", "ccd", "fabrik", or a function step(J, e) -> delta_theta
@@ -285,6 +302,14 @@ def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DE
               (default STALL_FRACTION * total link length; 0 turns it off).
     gamma_max SDLS's largest joint turn per step (default pi/4).
     weights   for a 4x4 pose target: (position_weight, orientation_weight), default (1, 1).
+    joint_limits  (lower, upper): per-joint arrays (or numbers), +-inf for no limit; every
+              theta of the result and trace stays within them (ikteach/joint_limits.py).
+    limit_mode    "clamping_loop" (default for Jacobian methods: pinned joints leave J and
+              the rest re-solves) or "clamp" (clip after the step; any method).
+    levels    priority of each target block, 0 first (one per end effector of a tree; for a
+              pose: position, orientation): each level is solved in the null space of those
+              before it (ikteach/levels.py).  rest_pose: a last level pulling theta towards
+              rest_pose with gain rest_gain in the freedom that is left.
     Returns a Result: theta, status, iterations, error (final ||e||) and trace.
     """
     method = resolve_method(method)
@@ -292,6 +317,8 @@ def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DE
         arm, target, theta0, tol=tol, max_iter=max_iter, damping=damping, rcond=rcond,
         clamp=clamp, max_step=max_step, stall_tol=stall_tol, gamma_max=gamma_max,
         weights=weights)
+    method, settings, theta0 = with_extras(method, task, arm, target, theta0, settings, levels,
+                                           rest_pose, rest_gain, joint_limits, limit_mode)
     args = (method, task, arm, target, theta0, settings, max_iter, True)
     state = (_run_jit if traceable(*args[:6]) else _run_eager)(*args)
     k = int(state.i)

@@ -15,7 +15,8 @@ from ._validate import as_array, as_number
 from .limits import cap_step
 from .pinv import DEFAULT_RCOND
 from .sdls import GAMMA_MAX
-from .solve import DEFAULT_DAMPING, Settings, resolve_method
+from .levels import DEFAULT_REST_GAIN
+from .solve import DEFAULT_DAMPING, Settings, resolve_method, with_extras
 from .tasks import task_for
 
 
@@ -53,7 +54,7 @@ def _track(method, task, arm, targets, theta0, settings, d_max):
         e = task.error(arm, target, theta)
         e = clamp_blocks(e, block or e.shape[0], d_max)
         delta = cap_step(method.delta(task, arm, target, theta, e, settings), settings.max_step)
-        new = theta + delta
+        new = jnp.clip(theta + delta, settings.lower, settings.upper)  # joint limits
         theta = jnp.where(jnp.all(jnp.isfinite(new)), new, theta)  # never NaN: keep the last finite
         e_after = task.error(arm, target, theta)
         err = jnp.sum(jnp.linalg.norm(e_after.reshape(-1, block or e_after.shape[0]), axis=1))
@@ -64,12 +65,14 @@ def _track(method, task, arm, targets, theta0, settings, d_max):
 
 
 def track(arm, targets, theta0=None, method="dls", damping=DEFAULT_DAMPING, rcond=DEFAULT_RCOND,
-          clamp=None, max_step=None, gamma_max=GAMMA_MAX):
+          clamp=None, max_step=None, gamma_max=GAMMA_MAX, joint_limits=None, limit_mode=None,
+          levels=None, rest_pose=None, rest_gain=DEFAULT_REST_GAIN):
     """Follow targets[0], targets[1], ... with one step of `method` each (Buss's protocol).
 
     targets  (T, *target shape): one target (or one per end effector) per time step.
     clamp    D_max: each end effector's error is clamped to at most D_max before the step.
     max_step cap on any joint's change per step (radians).
+    joint_limits, limit_mode, levels, rest_pose, rest_gain: as in ik.solve.
     """
     method = resolve_method(method)
     targets = as_array(targets, "targets")
@@ -82,6 +85,9 @@ def track(arm, targets, theta0=None, method="dls", damping=DEFAULT_DAMPING, rcon
         rcond=as_number(rcond, "rcond", minimum=0), clamp=np.inf,
         max_step=np.inf if max_step is None else as_number(max_step, "max_step", minimum=0, strict=True),
         stall_tol=0.0, gamma_max=as_number(gamma_max, "gamma_max", minimum=0, strict=True))
+    method, settings, theta0 = with_extras(method, task, arm, jnp.asarray(targets), jnp.asarray(theta0),
+                                           settings, levels, rest_pose, rest_gain, joint_limits,
+                                           limit_mode, batch=True)
     d_max = np.inf if clamp is None else as_number(clamp, "clamp", minimum=0, strict=True)
     thetas, errors = _track(method, task, arm, jnp.asarray(targets), jnp.asarray(theta0), settings,
                             jnp.asarray(d_max))

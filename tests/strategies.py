@@ -38,3 +38,13 @@ def matrices(draw, max_rows=6, max_cols=10):
     seed = draw(st.integers(0, 2**31 - 1))
     rng = np.random.default_rng(seed)
     return rng.normal(size=(m, n)), rng.normal(size=m)
+
+
+@st.composite
+def random_trees(draw, max_joints=8, max_effectors=3):
+    n = draw(st.integers(1, max_joints))
+    m = draw(st.integers(1, max_effectors))
+    rng = np.random.default_rng(draw(st.integers(0, 2**31 - 1)))
+    parents = [-1] + [int(rng.integers(0, j)) for j in range(1, n)]
+    return ik.tree(rng.normal(size=(n, 3)), rng.normal(size=(n, 3)), parents,
+                   rng.normal(size=(m, 3)), rng.integers(0, n, size=m).tolist())

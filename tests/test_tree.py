@@ -6,20 +6,11 @@ from hypothesis import strategies as st
 import ikteach as ik
 from ikteach import buss_trees
 from ikteach.tree import ancestors
+from strategies import random_trees
 
 Y = buss_trees.y_tree()
 DOUBLE_Y = buss_trees.double_y_tree()
 R2, H3 = 1 / np.sqrt(2), np.sqrt(3) / 2
-
-
-@st.composite
-def random_trees(draw, max_joints=8, max_effectors=3):
-    n = draw(st.integers(1, max_joints))
-    m = draw(st.integers(1, max_effectors))
-    rng = np.random.default_rng(draw(st.integers(0, 2**31 - 1)))
-    parents = [-1] + [int(rng.integers(0, j)) for j in range(1, n)]
-    return ik.tree(rng.normal(size=(n, 3)), rng.normal(size=(n, 3)), parents,
-                   rng.normal(size=(m, 3)), rng.integers(0, n, size=m).tolist())
 
 
 @given(random_trees(), st.integers(0, 2**31 - 1))

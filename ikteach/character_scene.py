@@ -1,0 +1,38 @@
+"""A character in 3-D with pyvista: bones as tubes, joints as balls, on a floor; shown through
+ik.scene.show (a static PNG off screen, pyvista's live view in a live Jupyter)."""
+import numpy as np
+
+from .scene import WINDOW, _pv
+
+BONE_COLORS = {"Left": "#4c72b0", "Right": "#dd8452"}
+OTHER = "#777777"
+UP = np.array([0.0, 1.0, 0.0])   # BVH: y up
+
+
+def character_scene(rig, points, targets=None, window_size=WINDOW, plotter=None):
+    """A pyvista Plotter with the pose (world points (m, 3) of rig.points) and targets (k, 3)
+    as purple balls; the camera looks at the character from the front-left, fixed."""
+    pv = _pv()
+    points = np.asarray(points, dtype=float)
+    p = plotter if plotter is not None else pv.Plotter(window_size=list(window_size),
+                                                       off_screen=pv.OFF_SCREEN or None)
+    p.set_background("white")
+    centre = points.mean(axis=0)
+    height = np.ptp(points[:, 1])
+    p.add_mesh(pv.Plane(center=(centre[0], 0.0, centre[2]), direction=UP, i_size=1.6 * height,
+                        j_size=1.6 * height), color="#eeeeee")
+    for a, b in rig.bones():
+        name = rig.points[b] if isinstance(rig.points[b], str) else rig.points[b][0]
+        colour = next((c for side, c in BONE_COLORS.items() if name.startswith(side)), OTHER)
+        if np.linalg.norm(points[b] - points[a]) > 1e-9:
+            p.add_mesh(pv.Tube(pointa=points[a], pointb=points[b], radius=0.018 * height, n_sides=16),
+                       color=colour, smooth_shading=True)
+    for q in points:
+        p.add_mesh(pv.Sphere(center=q, radius=0.025 * height), color="#333333", smooth_shading=True)
+    if targets is not None:
+        for t in np.asarray(targets, dtype=float).reshape(-1, 3):
+            p.add_mesh(pv.Sphere(center=t, radius=0.03 * height), color="#8172b3", opacity=0.6)
+    eye = centre + height * np.array([1.3, 0.35, 1.9])
+    p.camera_position = [tuple(eye), tuple(centre), tuple(UP)]
+    p.camera.view_angle = 30.0
+    return p

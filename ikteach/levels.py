@@ -1,0 +1,84 @@
+"""Priority levels in the solve loop: ik.solve(tree, targets, theta0, levels=..., rest_pose=...).
+
+levels[k] is the priority of the k-th block of the target (0 first): one block per end
+effector for a tree, the position and the orientation for a 4x4 pose target, the whole
+target for a point on a chain. Each level is solved in the null space of all the levels
+before it (ik.multilevel_step), so e.g. feet (level 0) stay planted while a hand (level 1)
+reaches as far as the feet allow. rest_pose adds one last level, e = gain (theta_rest - theta)
+with J = I: with the freedom that is still left, drift back towards a preferred pose.
+
+The loop itself is unchanged: it stops "converged" when the whole error (every level,
+not the rest pose) is below tol, and "stalled" when the levels conflict and the step dies out.
+"""
+import dataclasses
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from ._validate import as_array, as_number
+from .limits import clamp_error
+from .pose import PoseTask
+from .priority import multilevel_step
+
+DEFAULT_REST_GAIN = 0.1
+
+
+def block_size(task, rows):
+    """Rows per block of the error: 3 per effector (trees), 3 + 3 for a pose, else all."""
+    if isinstance(task, PoseTask):
+        return 3
+    return getattr(task, "block_size", None) or rows
+
+
+@dataclasses.dataclass(frozen=True)
+class PriorityMethod:
+    """The damped multilevel priority step as a solve method (levels: one per error block)."""
+    levels: tuple
+    rest: bool
+
+    def rows_by_level(self, rows, block):
+        per_row = np.repeat(np.asarray(self.levels), block)
+        return [np.flatnonzero(per_row == level) for level in sorted(set(self.levels))]
+
+    def jacobian_step(self, task, theta, settings):
+        """(J, e) -> delta: J's rows split by level, the rest pose (if any) as the last level."""
+        def step(J, e, free):
+            groups = self.rows_by_level(J.shape[0], block_size(task, J.shape[0]))
+            parts = [(J[rows], e[rows]) for rows in groups]
+            if self.rest:  # J = I, less the joints the caller pinned (free = False)
+                rest_error = settings.rest_gain * (settings.rest_pose - theta)
+                parts.append((jnp.diag(free.astype(J.dtype)), rest_error))
+            return multilevel_step(parts, settings.damping)
+        return step
+
+    def delta(self, task, arm, target, theta, e, settings):
+        J = task.jacobian(arm, theta)
+        free = jnp.ones(theta.shape[0], bool)
+        return self.jacobian_step(task, theta, settings)(J, clamp_error(e, settings.clamp), free)
+
+
+def with_priorities(method, task, arm, target, theta0, settings, levels, rest_pose, rest_gain,
+                    is_default):
+    """The solve's method and settings with priority levels / a rest pose (unchanged without)."""
+    if levels is None and rest_pose is None:
+        return method, settings
+    if not is_default:
+        raise ValueError("method: levels= and rest_pose= use the damped priority step "
+                         "(ik.multilevel_step with damping=); leave method='dls'")
+    rows = jax.eval_shape(lambda q: task.error(arm, target, q), theta0).shape[0]
+    blocks = rows // block_size(task, rows)
+    if levels is None:
+        levels = (0,) * blocks
+    try:
+        levels = tuple(int(v) for v in levels)
+    except (TypeError, ValueError):
+        raise ValueError(f"levels: expected one integer priority per target block, got {levels!r:.80}") from None
+    if len(levels) != blocks or min(levels) < 0:
+        raise ValueError(f"levels: expected {blocks} priorities >= 0 (one per "
+                         f"{'end effector' if blocks > 1 else 'target'}), got {list(levels)}")
+    if rest_pose is not None:
+        rest_pose = as_array(rest_pose, "rest_pose", shape=(arm.n_joints,))
+        gain = as_number(rest_gain, "rest_gain", minimum=0, strict=True)
+        settings = settings._replace(rest_pose=jnp.asarray(rest_pose), rest_gain=gain)
+    return PriorityMethod(levels, rest_pose is not None), settings
