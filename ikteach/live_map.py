@@ -68,6 +68,7 @@ class LiveMap:
         self._im = self._ax.imshow(np.zeros(self.grid.shape), origin="lower",
                                    extent=self.grid.extent, interpolation="nearest")
         self._ax.set_aspect("equal")
+        self._ax.grid(False)
         self._title = self._ax.set_title("", fontsize=8)
         self._holding = False
         for control in (self.damping, self.method, self.quantity):
