@@ -17,7 +17,7 @@ import numpy as np
 import ikteach as ik
 from ikteach.solve import STALL_FRACTION
 
-import scalar_loop
+import native  # benchmarks/native: the scalar C loop
 
 LENGTHS = np.array([1.0, 1.0, 1.0])
 THETA0 = np.array([0.3, 0.3, 0.3])
@@ -85,10 +85,10 @@ def main():
     compile_and_run = time.perf_counter() - t0
     jax_time, batch = best_of(args.repeats, lambda: ik.solve_batch(arm, targets, THETA0, **kw))
 
-    lib = scalar_loop.build()
+    lib = native.build()
     if lib is not None:
         stall_tol = STALL_FRACTION * LENGTHS.sum()
-        c_time, (c_status, c_iters, _, c_total) = best_of(args.repeats, lambda: scalar_loop.run(
+        c_time, (c_status, c_iters, _, c_total) = best_of(args.repeats, lambda: native.run(
             lib, LENGTHS, targets, THETA0, TOL, DAMPING, stall_tol, MAX_ITER))
 
     rng = np.random.default_rng(0)

@@ -1,4 +1,4 @@
-"""Build benchmarks/dls_loop.c with gcc at bench time and call it through ctypes.
+"""Build benchmarks/native/dls_loop.c with gcc at bench time and call it through ctypes.
 
     lib = build()                     # compiles into a temporary folder
     status, iterations, error, total = run(lib, lengths, targets, theta0, tol, damping,
