@@ -1,12 +1,15 @@
-"""Targets per second: ik.solve_batch (jit + vmap, timed after compiling) against a plain
-numpy loop over targets with the same DLS method, tolerance, iteration cap and stop rules.
+"""Targets per second on a workspace grid: ik.solve_batch (jit + vmap, timed after compiling)
+against the same DLS loop as compiled scalar C (the physical anchor, built here with gcc and
+called through ctypes) and as a plain numpy loop, with the same tolerance, iteration cap and
+stop rules. Every row prints its iteration total: the rows do the same work.
 
-    .venv/bin/python benchmarks/sweep.py [--n 256] [--numpy-subset 2048]
+    .venv/bin/python benchmarks/sweep.py [--n 256] [--numpy-subset 2048] [--repeats 3]
 
 The numpy loop is timed on a subset of the grid (it takes minutes for all 65,536 targets)
 and its rate is reported per target; the table says how many targets each row timed.
 """
 import argparse
+import os
 import time
 
 import numpy as np
@@ -14,9 +17,11 @@ import numpy as np
 import ikteach as ik
 from ikteach.solve import STALL_FRACTION
 
+import native  # benchmarks/native: the scalar C loop
+
 LENGTHS = np.array([1.0, 1.0, 1.0])
-THETA0 = np.array([0.3, 0.6, 0.6])
-TOL, MAX_ITER, DAMPING = 1e-3, 100, 0.5
+THETA0 = np.array([0.3, 0.3, 0.3])
+TOL, MAX_ITER, DAMPING = 1e-3, 200, 0.5
 
 
 def numpy_dls(target, theta, lengths=LENGTHS, tol=TOL, max_iter=MAX_ITER, damping=DAMPING):
@@ -46,6 +51,21 @@ def numpy_dls(target, theta, lengths=LENGTHS, tol=TOL, max_iter=MAX_ITER, dampin
     raise AssertionError("unreachable")
 
 
+def best_of(repeats, fn):
+    times, out = [], None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return min(times), out
+
+
+def table_row(name, timed, seconds, iterations):
+    rate = timed / seconds
+    print(f"| {name:<40} | {timed:>9} | {iterations:>12,} | {seconds:>8.3f} | {rate:>11,.0f} |")
+    return rate
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--n", type=int, default=256, help="grid side: n*n targets")
@@ -63,38 +83,48 @@ def main():
     t0 = time.perf_counter()
     ik.solve_batch(arm, targets, THETA0, **kw)
     compile_and_run = time.perf_counter() - t0
-    times = []
-    for _ in range(args.repeats):
-        t0 = time.perf_counter()
-        batch = ik.solve_batch(arm, targets, THETA0, **kw)
-        times.append(time.perf_counter() - t0)
-    jax_time = min(times)
+    jax_time, batch = best_of(args.repeats, lambda: ik.solve_batch(arm, targets, THETA0, **kw))
+
+    lib = native.build()
+    if lib is not None:
+        stall_tol = STALL_FRACTION * LENGTHS.sum()
+        c_time, (c_status, c_iters, _, c_total) = best_of(args.repeats, lambda: native.run(
+            lib, LENGTHS, targets, THETA0, TOL, DAMPING, stall_tol, MAX_ITER))
 
     rng = np.random.default_rng(0)
     subset = rng.choice(len(targets), size=min(args.numpy_subset, len(targets)), replace=False)
     t0 = time.perf_counter()
     ref = [numpy_dls(targets[k], THETA0) for k in subset]
     np_time = time.perf_counter() - t0
-    agree = np.mean([s == batch.status[k] and it == batch.iterations[k]
-                     for (s, it), k in zip(ref, subset)])
 
-    jax_rate = len(targets) / jax_time
-    np_rate = len(subset) / np_time
     print(f"planar arm {LENGTHS.tolist()}, DLS (damping {DAMPING}), tol {TOL}, max_iter {MAX_ITER}, "
-          f"theta0 {THETA0.tolist()}")
+          f"theta0 {THETA0.tolist()}; {os.cpu_count()} CPU cores")
     print(f"grid {args.n} x {args.n} = {len(targets)} targets over [-{half:.2f}, {half:.2f}]^2; "
           f"statuses {batch.counts()}")
     print()
-    print(f"| {'implementation':<34} | {'targets timed':>13} | {'seconds':>8} | {'targets/s':>11} |")
-    print(f"|{'-' * 36}|{'-' * 15}|{'-' * 10}|{'-' * 13}|")
-    print(f"| {'ik.solve_batch (jit+vmap), compiled':<34} | {len(targets):>13} | {jax_time:>8.2f} | "
-          f"{jax_rate:>11.0f} |")
-    print(f"| {'plain numpy loop over targets':<34} | {len(subset):>13} | {np_time:>8.2f} | "
-          f"{np_rate:>11.0f} |")
+    print(f"| {'implementation':<40} | {'targets':>9} | {'iterations':>12} | {'seconds':>8} | "
+          f"{'targets/s':>11} |")
+    print(f"|{'-' * 42}|{'-' * 11}|{'-' * 14}|{'-' * 10}|{'-' * 13}|")
+    jax_rate = table_row("ik.solve_batch (jit+vmap), compiled", len(targets), jax_time,
+                         int(batch.iterations.sum()))
+    if lib is not None:
+        c_rate = table_row("scalar C loop (gcc -O3, ctypes), 1 core", len(targets), c_time, c_total)
+    np_rate = table_row("plain numpy loop over targets", len(subset), np_time,
+                        sum(it for _, it in ref))
     print()
-    print(f"speed-up: {jax_rate / np_rate:.0f}x   (first call incl. compile: {compile_and_run:.2f} s; "
-          f"best of {args.repeats} runs after)")
-    print(f"numpy and JAX agree on status and iteration count for {agree:.1%} of the subset")
+    print(f"first solve_batch call incl. compile: {compile_and_run:.2f} s; best of {args.repeats} "
+          f"runs after")
+    print(f"solve_batch vs numpy: {jax_rate / np_rate:.0f}x faster")
+    if lib is not None:
+        names = np.asarray(ik.STATUSES, dtype=object)[c_status]
+        same = np.mean((names == batch.status) & (c_iters == batch.iterations))
+        print(f"solve_batch vs scalar C: {c_rate / jax_rate:.2f}x slower "
+              f"(goal <= 3x); same status and iteration count for {same:.2%} of the targets")
+    else:
+        print("scalar C row skipped: no C compiler (gcc or cc) found")
+    agree = np.mean([s == batch.status[k] and it == batch.iterations[k]
+                     for (s, it), k in zip(ref, subset)])
+    print(f"numpy and solve_batch agree on status and iteration count for {agree:.1%} of the subset")
 
 
 if __name__ == "__main__":

@@ -52,7 +52,24 @@ def fk(arm, theta):
     return joint_frames(arm, theta)[0][-1, : arm.dim]
 
 
+PATH_CHUNK = 128  # end_path works in blocks of this many rows: one compile per arm shape
+
+
+@jax.jit
+def _end_block(arm, thetas):
+    return jax.vmap(lambda q: fk(arm, q))(thetas)
+
+
 def end_path(arm, thetas):
-    """End-effector positions F(theta_k) for each row of thetas (k, n): shape (k, d)."""
-    thetas = jnp.asarray(thetas, dtype=float)
-    return np.asarray(jax.vmap(lambda q: fk(arm, q))(thetas))
+    """End-effector positions F(theta_k) for each row of thetas (k, n): shape (k, d).
+
+    Traces differ in length; padding them to whole blocks of PATH_CHUNK rows keeps one
+    compiled shape, so a new length costs no compilation.
+    """
+    thetas = np.asarray(thetas, dtype=float)
+    k = thetas.shape[0]
+    rows = -(-max(k, 1) // PATH_CHUNK) * PATH_CHUNK
+    padded = np.zeros((rows,) + thetas.shape[1:])
+    padded[:k] = thetas
+    blocks = [_end_block(arm, padded[i:i + PATH_CHUNK]) for i in range(0, rows, PATH_CHUNK)]
+    return np.concatenate([np.asarray(b) for b in blocks])[:k]

@@ -321,6 +321,7 @@ def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DE
                                            rest_pose, rest_gain, joint_limits, limit_mode)
     args = (method, task, arm, target, theta0, settings, max_iter, True)
     state = (_run_jit if traceable(*args[:6]) else _run_eager)(*args)
+    state = jax.device_get(state)  # slice on the host: a device slice would compile per length
     k = int(state.i)
     trace = Trace(_frozen(state.trace_theta[: k + 1]), _frozen(state.trace_error[: k + 1]))
     return Result(_frozen(state.theta), STATUSES[int(state.status)], k, float(state.error), trace)

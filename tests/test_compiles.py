@@ -1,0 +1,58 @@
+"""No recompilation after the first solve of a given (method, arm shape, max_iter, target
+kind): new targets, damping, tolerances, clamps and iteration counts compile nothing."""
+import numpy as np
+import pytest
+from jax import monitoring
+
+import ikteach as ik
+from ikteach.kinematics import end_path
+
+ARM = ik.planar_chain([1.0, 1.0, 1.0])
+START = np.array([0.1, 0.2, 0.3])
+METHODS = ("jt", "pinv", "dls", "sdls", "ccd", "fabrik")
+COMPILES = []
+
+
+def _count(event, duration, **kwargs):
+    if event.endswith("backend_compile_duration"):
+        COMPILES.append(event)
+
+
+monitoring.register_event_duration_secs_listener(_count)
+
+
+def varied_solves(rng, count):
+    """count solves cycling through the methods with varied targets and settings."""
+    results = []
+    for k in range(count):
+        results.append(ik.solve(
+            ARM, rng.uniform(-3.5, 3.5, size=2), START, method=METHODS[k % len(METHODS)],
+            max_iter=300, damping=rng.uniform(0.05, 1.5), tol=rng.choice([1e-2, 1e-3, 1e-5]),
+            clamp=rng.choice([None, 0.3, 1.0]), max_step=rng.choice([None, 0.2])))
+    return results
+
+
+def test_the_counter_sees_a_compilation():
+    before = len(COMPILES)
+    ik.solve(ARM, [1.0, 1.0], START, max_iter=7)  # a max_iter no other test uses
+    assert len(COMPILES) > before
+
+
+def test_twenty_varied_solves_compile_nothing_new():
+    rng = np.random.default_rng(3)
+    for res in varied_solves(rng, len(METHODS)):  # the first solve of each method compiles
+        end_path(ARM, res.trace.theta)
+    before = len(COMPILES)
+    results = varied_solves(rng, 20)
+    for res in results:
+        end_path(ARM, res.trace.theta)  # traces of every length: the demo draws them
+    assert len(COMPILES) == before, COMPILES[before:]
+    assert len({res.iterations for res in results}) > 5  # iteration counts did vary
+    assert {res.status for res in results} >= {"converged", "stalled"}
+
+
+@pytest.mark.parametrize("k", [1, 5, 128, 129, 300])
+def test_end_path_in_blocks_equals_fk_row_by_row(k):
+    thetas = np.random.default_rng(k).normal(size=(k, 3))
+    want = np.array([np.asarray(ik.fk(ARM, q)) for q in thetas])
+    np.testing.assert_allclose(end_path(ARM, thetas), want, atol=1e-12)

@@ -1,0 +1,46 @@
+"""import ikteach stays light: heavy libraries load on first use of the modules that need them."""
+import subprocess
+import sys
+
+HEAVY = ("matplotlib", "pyvista", "skimage", "ipywidgets")
+
+
+def _run(code):
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    return out.stdout.split()
+
+
+def test_import_loads_no_heavy_library():
+    code = "import sys, ikteach; print(*[m for m in %r if m in sys.modules])" % (HEAVY,)
+    assert _run(code) == []
+
+
+def test_lazy_modules_work_as_attributes():
+    code = ("import sys, ikteach as ik; ik.workspace.target_grid; ik.plot.draw_arm; "
+            "ik.demo.Demo; ik.scene.scene; ik.check; from ikteach import tree_plot; "
+            "print('matplotlib' in sys.modules, sorted(set(ik.LAZY) - set(dir(ik))))")
+    assert _run(code) == ["True", "[]"]
+
+
+def test_an_unknown_attribute_is_an_attribute_error():
+    code = ("import ikteach as ik\ntry:\n    ik.no_such_thing\nexcept AttributeError as e:\n"
+            "    print('no_such_thing' in str(e))")
+    assert _run(code) == ["True"]
+
+
+def test_compilation_cache_folder_from_the_environment(tmp_path, monkeypatch):
+    import jax
+    from ikteach import notebook
+
+    monkeypatch.setenv(notebook.CACHE_ENV, "off")
+    assert notebook.default_cache_dir() is None
+    assert notebook.compilation_cache() is None
+    monkeypatch.setenv(notebook.CACHE_ENV, str(tmp_path / "jit"))
+    assert notebook.default_cache_dir() == str(tmp_path / "jit")
+    old = jax.config.jax_compilation_cache_dir
+    try:
+        assert notebook.compilation_cache() == str(tmp_path / "jit")
+        assert jax.config.jax_compilation_cache_dir == str(tmp_path / "jit")
+        assert (tmp_path / "jit").is_dir()
+    finally:
+        jax.config.update("jax_compilation_cache_dir", old)
