@@ -2,6 +2,8 @@
 
 Parts: the rule 5, the rule ending ik.solve (through ik.StopSolve) 5.
 """
+import functools
+
 import numpy as np
 
 from ..chain import planar_chain
@@ -28,6 +30,11 @@ STOP_DAMPING = 1.0            # enough damping for DLS to settle (exercise 6: le
 def _stalled_reference(delta_theta, lengths, fraction):
     """The report's rule: stop when sum |delta_theta_i| < fraction * (total link length)."""
     return float(np.sum(np.abs(delta_theta))) < fraction * float(np.sum(lengths))
+
+
+# the step the student's stop rule wraps (a partial of ikteach's own function, so that the
+# grader can hand it to the student's code in another process by its name)
+_BASE_STEP = functools.partial(_ref_dls, damping=STOP_DAMPING)
 
 
 def _total(lengths):
@@ -110,11 +117,8 @@ def _stop_parts(stalled, stop_rule_step):
                 return advice + detail
         return "stop when sum |delta_theta_i| < fraction * (sum of lengths)." + detail
 
-    def base_step(J, e):
-        return _ref_dls(J, e, STOP_DAMPING)
-
     def reference_step(J, e):
-        delta = np.asarray(base_step(J, e))
+        delta = np.asarray(_BASE_STEP(J, e))
         if _stalled_reference(delta, STOP_ARM, STOP_FRACTION):
             raise StopSolve("out of reach")
         return delta
@@ -136,7 +140,7 @@ def _stop_parts(stalled, stop_rule_step):
         _check_callable(stop_rule_step, names[1])
         case = (f"stop_rule_step(step, lengths={STOP_ARM}, fraction={STOP_FRACTION:g}) with "
                 f"step = DLS (damping {STOP_DAMPING:g})")
-        step = _call(stop_rule_step, names[1], case, base_step, list(STOP_ARM), STOP_FRACTION)
+        step = _call(stop_rule_step, names[1], case, _BASE_STEP, list(STOP_ARM), STOP_FRACTION)
         if not callable(step):
             return (f"`{names[1]}` must return a step function step(J, e) -> delta_theta; "
                     f"it returned {type(step).__name__}.")
