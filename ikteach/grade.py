@@ -214,8 +214,9 @@ def _best(results):
 
 
 def grade_all(submissions, out, feedback=None, timeout=NOTEBOOK_TIMEOUT, jobs=1,
-              grade_timeout=GRADE_TIMEOUT, log=print, limits=None, bwrap=None):
-    """Grade every student folder; write the CSV and the feedback files; return the rows."""
+              grade_timeout=GRADE_TIMEOUT, log=print, limits=None, bwrap=None, collect=None):
+    """Grade every student folder; write the CSV and the feedback files; return the rows
+    (`collect`: a list that receives every notebook's result dict)."""
     from .grading.sandbox import Limits, Sandbox
 
     students = _students(submissions)
@@ -242,6 +243,8 @@ def grade_all(submissions, out, feedback=None, timeout=NOTEBOOK_TIMEOUT, jobs=1,
             outcomes = [grade_notebook(nb, timeout, grade_timeout, sandbox) for _, nb in jobs_list]
     finally:
         sandbox.close()
+    if collect is not None:
+        collect.extend(outcomes)
     per_student = {s.name: [] for s in students}
     for (student, _), result in zip(jobs_list, outcomes):
         per_student[student].append(result)
