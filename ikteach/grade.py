@@ -102,6 +102,9 @@ def _run_cells(path, work, sandbox, timeout):
                     "memory or file-size limit)"]
 
 
+ANSWER_PLACEHOLDER = "*(Write your answer here.)*"  # = ikteach.exercises.ANSWER_PLACEHOLDER
+
+
 def _answer_text(book):
     """The student's written answer (Markdown cells tagged `answer`), for the instructor."""
     texts = []
@@ -109,7 +112,9 @@ def _answer_text(book):
         tags = cell.get("metadata", {}).get("tags", []) if isinstance(cell, dict) else []
         if cell.get("cell_type") == "markdown" and "answer" in tags:
             source = cell.get("source", "")
-            texts.append("".join(source) if isinstance(source, list) else str(source))
+            text = "".join(source) if isinstance(source, list) else str(source)
+            if text.strip() != ANSWER_PLACEHOLDER:  # the template's, untouched
+                texts.append(text)
     return "\n".join(texts)[:4000]
 
 
