@@ -29,10 +29,11 @@ import shutil
 import subprocess
 import sys
 import tempfile
-import time
 from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
 from pathlib import Path
+
+from .exercises import ANSWER_PLACEHOLDER
 
 NOTEBOOK_TIMEOUT = 120.0  # seconds for all of a student's cells
 GRADE_TIMEOUT = 180.0     # kept for the command line; each check call has its own limit
@@ -45,7 +46,8 @@ INSTRUCTOR = Path(__file__).resolve().parents[1] / "instructor"  # the solutions
 
 def exercise_number(path, book):
     """The exercise a notebook answers: its metadata (ikteach.exercise), else NN_ in its name."""
-    meta = book.get("metadata", {}).get("ikteach", {}) if isinstance(book, dict) else {}
+    meta = book.get("metadata") if isinstance(book, dict) else None
+    meta = meta.get("ikteach") if isinstance(meta, dict) else None
     number = meta.get("exercise") if isinstance(meta, dict) else None
     if isinstance(number, int) and number in EXERCISE_NUMBERS:
         return number
@@ -102,15 +104,13 @@ def _run_cells(path, work, sandbox, timeout):
                     "memory or file-size limit)"]
 
 
-ANSWER_PLACEHOLDER = "*(Write your answer here.)*"  # = ikteach.exercises.ANSWER_PLACEHOLDER
-
-
 def _answer_text(book):
     """The student's written answer (Markdown cells tagged `answer`), for the instructor."""
     texts = []
-    for cell in book.get("cells", []):
-        tags = cell.get("metadata", {}).get("tags", []) if isinstance(cell, dict) else []
-        if cell.get("cell_type") == "markdown" and "answer" in tags:
+    for cell in (c for c in book["cells"] if isinstance(c, dict)):
+        meta = cell.get("metadata")
+        tags = meta.get("tags") if isinstance(meta, dict) else None
+        if cell.get("cell_type") == "markdown" and isinstance(tags, list) and "answer" in tags:
             source = cell.get("source", "")
             text = "".join(source) if isinstance(source, list) else str(source)
             if text.strip() != ANSWER_PLACEHOLDER:  # the template's, untouched
@@ -128,11 +128,10 @@ def _check(number, book, work, sandbox):
     check_dir.mkdir()
     worker = Worker(code_cells(book), sandbox, check_dir)
     try:
-        worker.start()
-    except ProcessEnded as exc:
-        worker.end()
-        return None, [f"your code could not be loaded for the checks: {exc}"]
-    try:
+        try:
+            worker.start()
+        except (ProcessEnded, ValueError) as exc:  # died, hung, or answered garbage
+            return None, [f"your code could not be loaded for the checks: {exc}"]
         namespace = {name: worker.function(name) for name in worker.names}
         return check.grade(number, namespace), worker.notes
     finally:
@@ -158,9 +157,9 @@ def grade_notebook(path, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT, 
         result["message"] = ("not an exercise notebook (no ikteach exercise number in its "
                              "metadata or name)")
         return result
-    result["answer"] = _answer_text(book)
     work = Path(tempfile.mkdtemp(prefix="nb-", dir=sandbox.work_root))
     try:
+        result["answer"] = _answer_text(book)
         errors, notes = _run_cells(path, work, sandbox, timeout)
         verdict, check_notes = _check(number, book, work, sandbox)
         result["notes"] = errors + notes + check_notes

@@ -57,12 +57,16 @@ def test_solutions_get_full_marks(graded):
     rows, feedback, *_ = graded
     assert scores(rows["solutions"]) == ([10.0] * 6, 60.0)
     assert feedback["solutions"].count("passed, 10/10") == 6
+    # exercise 6's written answer is copied for the instructor, not marked
+    assert "your written answer (not marked by the checker" in feedback["solutions"]
+    assert "| Stretched towards a target it cannot reach" in feedback["solutions"]
 
 
 def test_untouched_templates_get_zero(graded):
     rows, feedback, *_ = graded
     assert scores(rows["untouched"]) == ([0.0] * 6, 0.0)
     assert feedback["untouched"].count("not yet implemented") == 6
+    assert "your written answer" not in feedback["untouched"]  # the placeholder is skipped
 
 
 @pytest.mark.parametrize("student, exercise, score, line", [

@@ -6,9 +6,8 @@ J J^T e = 0 2.
 import numpy as np
 
 from ..jt import jt_step as _ref_jt
-from .verdicts import (SEED, _Case, _Fail, _Part, _as_array, _call, _check_callable, _close,
-                       _evaluate, _fmt, _guarded, _matrix_text, _mismatch, _report,
-                       _shape_message, _random_matrix, _with_singular_values)
+from .verdicts import (SEED, _Case, _Fail, _Part, _as_array, _call, _close, _evaluate, _guarded,
+                       _matrix_text, _mismatch, _report, _shape_message)
 
 NUMBER = 2
 CHECK_NAME = "jt_step"

@@ -5,9 +5,9 @@ Parts: regular J 5, the cut-off at singular J 3, J = 0 (sigma_max = 0: nothing i
 import numpy as np
 
 from ..pinv import pinv_step as _ref_pinv
-from .verdicts import (SEED, _Case, _Fail, _Part, _as_array, _call, _check_callable, _close,
-                       _evaluate, _fmt, _guarded, _matrix_text, _mismatch, _report,
-                       _shape_message, _random_matrix, _with_singular_values)
+from .verdicts import (SEED, _Case, _Part, _as_array, _call, _close, _evaluate, _fmt, _guarded,
+                       _matrix_text, _mismatch, _report, _shape_message, _random_matrix,
+                       _with_singular_values)
 
 NUMBER = 3
 CHECK_NAME = "pinv_step"

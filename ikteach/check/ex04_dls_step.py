@@ -5,9 +5,8 @@ Parts: each form 4, the two forms agree 2.
 import numpy as np
 
 from ..dls import dls_step as _ref_dls
-from .verdicts import (SEED, _Case, _Fail, _Part, _as_array, _call, _check_callable, _close,
-                       _evaluate, _fmt, _guarded, _matrix_text, _mismatch, _report,
-                       _shape_message, _random_matrix, _with_singular_values)
+from .verdicts import (SEED, _Case, _Part, _as_array, _call, _check_callable, _close, _evaluate,
+                       _fmt, _matrix_text, _mismatch, _report, _shape_message)
 
 NUMBER = 4
 CHECK_NAME = "dls_step"

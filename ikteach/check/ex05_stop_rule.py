@@ -10,9 +10,8 @@ from ..chain import planar_chain
 from ..dls import dls_step as _ref_dls
 from ..solve import StopSolve
 from ..solve import solve as _solve
-from .verdicts import (SEED, SOLVE_LIMIT, _Case, _Fail, _Part, _as_array, _call, _check_callable, _close,
-                       _evaluate, _fmt, _guarded, _matrix_text, _mismatch, _report,
-                       _shape_message, _random_matrix, _with_singular_values)
+from .verdicts import (SEED, SOLVE_LIMIT, _Case, _Fail, _Part, _call, _check_callable, _evaluate,
+                       _fmt, _report)
 
 NUMBER = 5
 CHECK_NAME = "stop_rule"

@@ -13,9 +13,7 @@ from ..dls import dls_step as _ref_dls
 from ..jt import jt_step as _ref_jt
 from ..pinv import pinv_step as _ref_pinv
 from ..solve import solve as _solve
-from .verdicts import (SEED, SOLVE_LIMIT, _Case, _Fail, _Part, _as_array, _call, _check_callable, _close,
-                       _evaluate, _fmt, _guarded, _matrix_text, _mismatch, _report,
-                       _shape_message, _random_matrix, _with_singular_values)
+from .verdicts import (SOLVE_LIMIT, _Fail, _Part, _call, _check_callable, _evaluate, _report)
 
 NUMBER = 6
 CHECK_NAME = "singularity_study"
