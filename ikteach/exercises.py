@@ -4,7 +4,8 @@
 
 Solution notebooks (instructor/solutions/NN_name.ipynb) carry the answers between
 ``### BEGIN SOLUTION`` and ``### END SOLUTION`` lines. Each such region becomes one
-``raise NotImplementedError(...)`` line at the marker's indentation; outputs are cleared and
+``raise NotImplementedError(...)`` line at the marker's indentation (in a Markdown answer cell:
+"*(Write your answer here.)*"); outputs are cleared and
 the templates are executed (so they are committed with their check cells' output,
 "not yet implemented"). Anything outside the markers is copied as it is.
 """
@@ -16,12 +17,13 @@ from pathlib import Path
 BEGIN = "### BEGIN SOLUTION"
 END = "### END SOLUTION"
 PLACEHOLDER = 'raise NotImplementedError("replace this line with your code")'
+ANSWER_PLACEHOLDER = "*(Write your answer here.)*"  # in a Markdown cell (a written answer)
 ROOT = Path(__file__).resolve().parents[1]
 SOLUTIONS = ROOT / "instructor" / "solutions"
 TEMPLATES = ROOT / "notebooks" / "exercises"
 
 
-def strip_solutions(source):
+def strip_solutions(source, placeholder=PLACEHOLDER):
     """The cell source with every BEGIN/END SOLUTION region replaced by one placeholder line."""
     out, inside = [], False
     for number, line in enumerate(source.splitlines(), 1):
@@ -31,7 +33,7 @@ def strip_solutions(source):
                 raise ValueError(f"source: nested {BEGIN!r} at line {number}")
             inside = True
             indent = line[: len(line) - len(line.lstrip())]
-            out.append(indent + PLACEHOLDER)
+            out.append(indent + placeholder)
         elif stripped == END:
             if not inside:
                 raise ValueError(f"source: {END!r} without {BEGIN!r} at line {number}")
@@ -59,6 +61,8 @@ def template_from(solution):
             cell.source = strip_solutions(cell.source)
             cell.outputs = []
             cell.execution_count = None
+        elif cell.cell_type == "markdown" and BEGIN in cell.source:  # a written answer
+            cell.source = strip_solutions(cell.source, ANSWER_PLACEHOLDER)
     book.metadata.setdefault("ikteach", {})["template"] = True
     return book
 

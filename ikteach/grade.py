@@ -1,52 +1,53 @@
 """Grade the students' exercise notebooks.
 
     python -m ikteach.grade SUBMISSIONS_DIR --out grades.csv [--feedback DIR] [--timeout S]
-                            [--jobs N]
+                            [--jobs N] [--memory-mb M] [--no-bwrap]
+    python -m ikteach.grade --gradescope OUT.zip      (a Gradescope autograder bundle)
 
 SUBMISSIONS_DIR holds one folder per student (the folder name is the student), each with that
-student's exercise notebooks (NN_name.ipynb, as handed out). Every notebook runs in its own
-kernel process, in a fresh temporary working directory holding only a copy of it, under a time
-limit for the whole notebook. After the student's cells the grader runs its own cell, which
-calls ik.check on the student's functions (each call under its own time limit) and hands the
-score back through a one-time token. The notebook's own outputs are never trusted for marks.
+student's exercise notebooks (NN_name.ipynb, as handed out). For each notebook:
+
+1. its cells run in a kernel in a sandbox (ikteach.grading.sandbox: own temporary folder and
+   HOME, resource limits, and with bubblewrap no network, read-only file system, solutions and
+   other students hidden), for its errors and notes only - nothing it prints counts;
+2. the student's functions are taken from the notebook's source (top-level imports,
+   definitions and assignments, by the AST) into a second sandboxed process, and ik.check runs
+   in the grader's own process, calling them there through a pipe (each call under its time
+   limit). So nothing a notebook does to modules, builtins, stdout or files changes a score.
 
 Writes one CSV row per student (ex1..ex6 and total) and a feedback file per student
-(FEEDBACK/<student>.txt, by default a `feedback` folder next to the CSV). A submission that
-raises, loops forever, kills its kernel or deletes files in its working directory loses only
-its own marks; the grader finishes and says what happened in the feedback.
+(FEEDBACK/<student>.txt, by default a `feedback` folder next to the CSV); the log starts with
+what the sandbox enforces and what it cannot on this machine.
 """
 import argparse
 import csv
 import json
-import logging
+import os
 import re
-import secrets
+import select
 import shutil
+import subprocess
 import sys
 import tempfile
-import time
 from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
 from pathlib import Path
 
+from .exercises import ANSWER_PLACEHOLDER
+
 NOTEBOOK_TIMEOUT = 120.0  # seconds for all of a student's cells
-GRADE_TIMEOUT = 180.0     # seconds for the grader's own cell
+GRADE_TIMEOUT = 180.0     # kept for the command line; each check call has its own limit
 EXERCISE_NUMBERS = range(1, 7)
 POINTS = 10
-
-_GRADE_CELL = """\
-import json as _ikteach_json
-import ikteach.check as _ikteach_check
-_ikteach_verdict = _ikteach_check.grade({number}, globals())
-print({token!r} + _ikteach_json.dumps({{
-    "score": _ikteach_verdict.score, "max": _ikteach_verdict.max_score,
-    "status": _ikteach_verdict.status, "message": _ikteach_verdict.message}}))
-"""
+MAX_NOTEBOOK_BYTES = 20 << 20
+RUNNER = Path(__file__).with_name("grading") / "run_notebook.py"
+INSTRUCTOR = Path(__file__).resolve().parents[1] / "instructor"  # the solutions: hidden
 
 
 def exercise_number(path, book):
     """The exercise a notebook answers: its metadata (ikteach.exercise), else NN_ in its name."""
-    meta = book.get("metadata", {}).get("ikteach", {})
+    meta = book.get("metadata") if isinstance(book, dict) else None
+    meta = meta.get("ikteach") if isinstance(meta, dict) else None
     number = meta.get("exercise") if isinstance(meta, dict) else None
     if isinstance(number, int) and number in EXERCISE_NUMBERS:
         return number
@@ -56,33 +57,99 @@ def exercise_number(path, book):
     return None
 
 
-def _error_lines(book, upto):
-    """'cell k raised Name: value' for the student's cells that ended in an error."""
-    lines = []
-    for index, cell in enumerate(book.cells[:upto]):
-        for out in cell.get("outputs", []) if cell.cell_type == "code" else []:
-            if out.get("output_type") == "error":
-                value = str(out.get("evalue", "")).splitlines()
-                lines.append(f"cell {index + 1} raised {out.get('ename')}"
-                             f"{': ' + value[0][:200] if value and value[0] else ''}")
-    return lines
+def _read_book(path):
+    """The notebook as a dict, or a message saying why it is not one."""
+    if path.stat().st_size > MAX_NOTEBOOK_BYTES:
+        return None, f"the notebook is larger than {MAX_NOTEBOOK_BYTES >> 20} MB"
+    try:
+        book = json.loads(path.read_text(encoding="utf-8", errors="replace"))
+    except ValueError as exc:
+        return None, f"could not read the notebook: it is not JSON ({exc})"
+    if not isinstance(book, dict) or not isinstance(book.get("cells"), list):
+        return None, "could not read the notebook: no list of cells in it"
+    return book, None
 
 
-def grade_notebook(path, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT):
-    """Run one notebook in its own kernel and temp dir; returns a dict:
-    exercise, score, max, status, message, notes (list of what went wrong on the way)."""
-    import nbformat
-    from nbclient import NotebookClient
-    from nbclient.exceptions import CellTimeoutError, DeadKernelError
+def _run_cells(path, work, sandbox, timeout):
+    """Run the notebook's cells in the sandbox; (error lines, notes) from the runner's report."""
+    run_dir = work / "run"
+    run_dir.mkdir()
+    copy = run_dir / path.name
+    shutil.copy(path, copy)
+    read_end, write_end = os.pipe()
+    try:
+        process = sandbox.start([sys.executable, str(RUNNER), str(copy), f"{timeout:g}",
+                                 str(write_end)], run_dir, pass_fds=(write_end,),
+                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL)
+    finally:
+        os.close(write_end)
+    try:
+        status = process.wait(timeout + 60)
+    finally:
+        process.end()
+    report = b""
+    with os.fdopen(read_end, "rb") as pipe:
+        while select.select([pipe], [], [], 0)[0]:
+            chunk = os.read(pipe.fileno(), 1 << 16)
+            if not chunk or len(report) > 1 << 20:
+                break
+            report += chunk
+    try:
+        data = json.loads(report.decode(errors="replace").splitlines()[0])
+        return [str(e)[:400] for e in data["errors"]][:30], [str(n)[:400] for n in data["notes"]][:10]
+    except (ValueError, IndexError, KeyError, TypeError):
+        why = "it ran past its time limit" if status is None else f"exit status {status}"
+        return [], [f"the notebook's run ended without a report ({why}: a crash, or a CPU, "
+                    "memory or file-size limit)"]
 
-    logging.getLogger("asyncio").setLevel(logging.CRITICAL)  # nbclient noise after a timeout
+
+def _answer_text(book):
+    """The student's written answer (Markdown cells tagged `answer`), for the instructor."""
+    texts = []
+    for cell in (c for c in book["cells"] if isinstance(c, dict)):
+        meta = cell.get("metadata")
+        tags = meta.get("tags") if isinstance(meta, dict) else None
+        if cell.get("cell_type") == "markdown" and isinstance(tags, list) and "answer" in tags:
+            source = cell.get("source", "")
+            text = "".join(source) if isinstance(source, list) else str(source)
+            if text.strip() != ANSWER_PLACEHOLDER:  # the template's, untouched
+                texts.append(text)
+    return "\n".join(texts)[:4000]
+
+
+def _check(number, book, work, sandbox):
+    """The verdict from ik.check in this process, on the student's functions in a worker."""
+    from . import check
+    from .grading.extract import code_cells
+    from .grading.remote import ProcessEnded, Worker
+
+    check_dir = work / "check"
+    check_dir.mkdir()
+    worker = Worker(code_cells(book), sandbox, check_dir)
+    try:
+        try:
+            worker.start()
+        except (ProcessEnded, ValueError) as exc:  # died, hung, or answered garbage
+            return None, [f"your code could not be loaded for the checks: {exc}"]
+        namespace = {name: worker.function(name) for name in worker.names}
+        return check.grade(number, namespace), worker.notes
+    finally:
+        worker.end()
+
+
+def grade_notebook(path, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT, sandbox=None):
+    """Grade one notebook; returns a dict: file, exercise, score, max, status, message,
+    notes (what went wrong on the way), answer (the written answer, if any)."""
+    from .grading.sandbox import Sandbox
+
+    sandbox = sandbox or Sandbox()
     path = Path(path)
     result = {"file": path.name, "exercise": None, "score": 0.0, "max": float(POINTS),
-              "status": "not graded", "message": "", "notes": []}
-    try:
-        book = nbformat.read(path, as_version=4)
-    except Exception as exc:  # not a notebook at all
-        result["message"] = f"could not read the notebook: {type(exc).__name__}: {exc}"
+              "status": "not graded", "message": "", "notes": [], "answer": ""}
+    book, problem = _read_book(path)
+    if book is None:
+        result["message"] = problem
         return result
     number = exercise_number(path, book)
     result["exercise"] = number
@@ -90,93 +157,29 @@ def grade_notebook(path, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT):
         result["message"] = ("not an exercise notebook (no ikteach exercise number in its "
                              "metadata or name)")
         return result
-
-    token = f"IKTEACH-GRADE-{secrets.token_hex(12)}:"
-    student_cells = len(book.cells)
-    book.cells.append(nbformat.v4.new_code_cell(_GRADE_CELL.format(number=number, token=token)))
-    work = Path(tempfile.mkdtemp(prefix="ikteach-grade-"))
+    work = Path(tempfile.mkdtemp(prefix="nb-", dir=sandbox.work_root))
     try:
-        shutil.copy(path, work / path.name)
-        client = NotebookClient(book, timeout=timeout, kernel_name="python3",
-                                allow_errors=True, interrupt_on_timeout=False,
-                                shutdown_kernel="immediate", record_timing=False,
-                                resources={"metadata": {"path": str(work)}})
-        deadline = time.monotonic() + timeout
-        with client.setup_kernel():
-            for index, cell in enumerate(book.cells):
-                if cell.cell_type != "code":
-                    continue
-                grading = index == student_cells
-                if not grading and _only_checks(cell.source):
-                    continue  # the grader runs the checks itself, once, in its own cell
-                remaining = deadline - time.monotonic()
-                if not grading and remaining <= 0:
-                    result["notes"].append(f"time limit of {timeout:g} s reached: cells from "
-                                           f"cell {index + 1} on were not run")
-                    continue
-                client.timeout = int(max(1, grade_timeout if grading else remaining))
-                try:
-                    client.execute_cell(cell, index)
-                except CellTimeoutError:
-                    if grading:
-                        result["notes"].append("the checks did not finish in time")
-                        break
-                    result["notes"].append(f"cell {index + 1} did not finish within the "
-                                           f"notebook's time limit ({timeout:g} s)")
-                    _interrupt(client)
-                except DeadKernelError:
-                    result["notes"].append(f"the kernel died in cell {index + 1}")
-                    break
-        result["notes"][:0] = _error_lines(book, student_cells)
-        grade = _read_grade(book.cells[-1], token)
-        if grade is None:
-            result["message"] = "no grade: the checks could not run to the end"
+        result["answer"] = _answer_text(book)
+        errors, notes = _run_cells(path, work, sandbox, timeout)
+        verdict, check_notes = _check(number, book, work, sandbox)
+        result["notes"] = errors + notes + check_notes
+        if verdict is None:
+            result["message"] = "no grade: your code could not be loaded for the checks"
         else:
-            result.update(score=float(grade["score"]), max=float(grade["max"]),
-                          status=grade["status"], message=grade["message"])
+            result.update(score=float(verdict.score), max=float(verdict.max_score),
+                          status=verdict.status, message=verdict.message)
     except Exception as exc:  # the grader's own failure on this notebook: report, go on
-        result["message"] = f"could not run the notebook: {type(exc).__name__}: {exc}"
+        result["message"] = f"could not grade the notebook: {type(exc).__name__}: {exc}"
     finally:
         shutil.rmtree(work, ignore_errors=True)
     return result
 
 
-def _only_checks(source):
-    """A cell that only calls ik.check.<name>(...) (the template's check cells)."""
-    lines = [l for l in source.splitlines() if l.strip() and not l.strip().startswith("#")]
-    return bool(lines) and all(re.match(r"\s*ik\.check\.\w+\(.*\)\s*$", l) for l in lines)
-
-
-def _interrupt(client):
-    """Interrupt a busy kernel (the grader's cell still runs after a timed-out cell)."""
-    from jupyter_core.utils import ensure_async, run_sync
-
-    try:
-        run_sync(ensure_async)(client.km.interrupt_kernel())
-    except Exception:
-        pass
-    time.sleep(1.0)
-
-
-def _read_grade(cell, token):
-    """The grade the grading cell printed after `token` (stdout may arrive in several pieces)."""
-    text = "".join(out.get("text", "") for out in cell.get("outputs", [])
-                   if out.get("output_type") == "stream" and out.get("name") == "stdout")
-    for line in text.splitlines():
-        if line.startswith(token):
-            try:
-                return json.loads(line[len(token):])
-            except ValueError:
-                return None
-    return None
-
-
 def _students(submissions):
-    submissions = Path(submissions)
-    if not submissions.is_dir():
+    if submissions is None or not Path(submissions).is_dir():
         raise ValueError(f"SUBMISSIONS_DIR: expected a folder of student folders, "
                          f"got {str(submissions)!r}")
-    return sorted(p for p in submissions.iterdir() if p.is_dir() and not p.name.startswith("."))
+    return sorted(p for p in Path(submissions).iterdir() if p.is_dir() and not p.name.startswith("."))
 
 
 def _feedback_text(student, results):
@@ -192,6 +195,10 @@ def _feedback_text(student, results):
             lines.append(f"  {text}")
         for note in r["notes"]:
             lines.append(f"  note: {note}")
+        if r.get("answer", "").strip():
+            lines.append("  your written answer (not marked by the checker; read by the "
+                         "instructor):")
+            lines += [f"    | {text}" for text in r["answer"].strip().splitlines()]
     for r in results:
         if r["exercise"] is None:
             lines.append(f"{r['file']}: {r['message']}")
@@ -211,19 +218,37 @@ def _best(results):
 
 
 def grade_all(submissions, out, feedback=None, timeout=NOTEBOOK_TIMEOUT, jobs=1,
-              grade_timeout=GRADE_TIMEOUT, log=print):
-    """Grade every student folder; write the CSV and the feedback files; return the rows."""
+              grade_timeout=GRADE_TIMEOUT, log=print, limits=None, bwrap=None, collect=None):
+    """Grade every student folder; write the CSV and the feedback files; return the rows
+    (`collect`: a list that receives every notebook's result dict)."""
+    from .grading.sandbox import Limits, Sandbox
+
     students = _students(submissions)
     out = Path(out)
     feedback = Path(feedback) if feedback else out.parent / "feedback"
     feedback.mkdir(parents=True, exist_ok=True)
+    hidden = [submissions, out.parent, feedback, INSTRUCTOR]
+    sandbox = Sandbox(hidden, limits or Limits(), bwrap=bwrap)
+    enforced, not_enforced = sandbox.report()
+    log("sandbox: enforced:")
+    for line in enforced:
+        log(f"  + {line}")
+    log("sandbox: NOT enforced:")
+    for line in not_enforced:
+        log(f"  - {line}")
     jobs_list = [(s.name, nb) for s in students for nb in sorted(s.glob("*.ipynb"))]
-    if jobs > 1:
-        with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
-            futures = [pool.submit(grade_notebook, nb, timeout, grade_timeout) for _, nb in jobs_list]
-            outcomes = [f.result() for f in futures]
-    else:
-        outcomes = [grade_notebook(nb, timeout, grade_timeout) for _, nb in jobs_list]
+    try:
+        if jobs > 1:
+            with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
+                futures = [pool.submit(grade_notebook, nb, timeout, grade_timeout, sandbox)
+                           for _, nb in jobs_list]
+                outcomes = [f.result() for f in futures]
+        else:
+            outcomes = [grade_notebook(nb, timeout, grade_timeout, sandbox) for _, nb in jobs_list]
+    finally:
+        sandbox.close()
+    if collect is not None:
+        collect.extend(outcomes)
     per_student = {s.name: [] for s in students}
     for (student, _), result in zip(jobs_list, outcomes):
         per_student[student].append(result)
@@ -249,11 +274,13 @@ def grade_all(submissions, out, feedback=None, timeout=NOTEBOOK_TIMEOUT, jobs=1,
 
 
 def main(argv=None):
+    from .grading.sandbox import Limits
+
     parser = argparse.ArgumentParser(prog="python -m ikteach.grade",
                                      description="Grade exercise notebooks, one folder per "
                                                  "student.")
-    parser.add_argument("submissions", metavar="SUBMISSIONS_DIR")
-    parser.add_argument("--out", required=True, help="the CSV to write (one row per student)")
+    parser.add_argument("submissions", metavar="SUBMISSIONS_DIR", nargs="?")
+    parser.add_argument("--out", help="the CSV to write (one row per student)")
     parser.add_argument("--feedback", default=None,
                         help="folder for <student>.txt (default: feedback/ next to --out)")
     parser.add_argument("--timeout", type=float, default=NOTEBOOK_TIMEOUT,
@@ -261,10 +288,26 @@ def main(argv=None):
     parser.add_argument("--grade-timeout", type=float, default=GRADE_TIMEOUT,
                         help="seconds allowed for the grader's checks (default %(default)s)")
     parser.add_argument("--jobs", type=int, default=1, help="notebooks graded at once")
+    parser.add_argument("--memory-mb", type=int, default=Limits.memory_mb,
+                        help="address space of one student process (default %(default)s)")
+    parser.add_argument("--cpu-s", type=int, default=Limits.cpu_seconds,
+                        help="CPU seconds of one student process (default %(default)s)")
+    parser.add_argument("--no-bwrap", action="store_true",
+                        help="do not use bubblewrap even where it works")
+    parser.add_argument("--gradescope", metavar="OUT.zip",
+                        help="write a Gradescope autograder bundle instead of grading")
     args = parser.parse_args(argv)
+    if args.gradescope:
+        from .grading.gradescope import bundle
+        print(f"wrote {bundle(args.gradescope)}")
+        return 0
+    if not args.out:
+        parser.error("--out is required (the CSV to write)")
+    limits = Limits(cpu_seconds=args.cpu_s, memory_mb=args.memory_mb)
     try:
         rows = grade_all(args.submissions, args.out, args.feedback, args.timeout, args.jobs,
-                         args.grade_timeout)
+                         args.grade_timeout, limits=limits,
+                         bwrap=False if args.no_bwrap else None)
     except ValueError as exc:
         parser.error(str(exc))
     print(f"wrote {args.out}: {len(rows)} student(s)")

@@ -39,6 +39,13 @@ def stop_rule_step(step, lengths, fraction):
     return wrapped
 
 
+def wrong_lever_arm(lengths, theta):
+    """Column i from the next joint's position (p_{i+1}) instead of p_i."""
+    p = np.asarray(ik.joint_positions(ik.planar_chain(lengths), theta))
+    d = p[-1] - p[1:]
+    return np.stack([-d[:, 1], d[:, 0]])
+
+
 def not_yet(*args):
     raise NotImplementedError
 
@@ -51,7 +58,8 @@ def test_correct_functions_pass():
 
 
 @pytest.mark.parametrize("wrong, score, words", [
-    (lambda L, t: -planar_jacobian(L, t), 2, "wrong sign"),
+    (lambda L, t: -planar_jacobian(L, t), 6, "wrong sign"),  # lever arms right: 6 of 10
+    (lambda L, t: wrong_lever_arm(L, t), 2, "wrong values"),
     (lambda L, t: planar_jacobian(L, t).T, 0, "transposed"),
     (lambda L, t: planar_jacobian(L, t)[:, ::-1], 2, "reverse order"),
     (lambda L, t: None, 0, "forget `return`"),
@@ -72,9 +80,9 @@ def test_the_smallest_failing_case_is_shown():
 
 
 @pytest.mark.parametrize("wrong, score, words", [
-    (lambda J, e: 0.1 * (J.T @ e), 6, "alpha looks fixed: it is 0.1"),
-    (lambda J, e: 2 * jt_step(J, e), 6, "off by a factor of 2"),
-    (lambda J, e: -jt_step(J, e), 2, "wrong sign"),
+    (lambda J, e: 0.1 * (J.T @ e), 7, "alpha looks fixed: it is 0.1"),
+    (lambda J, e: 2 * jt_step(J, e), 7, "off by a factor of 2"),
+    (lambda J, e: -jt_step(J, e), 7, "wrong sign"),  # direction and alpha's size are right
 ])
 def test_jt_mistakes(wrong, score, words):
     verdict = check.jt_step_verdict(wrong)
@@ -93,11 +101,24 @@ def test_jt_nan_at_zero_error_is_named():
 
 def test_pinv_without_cutoff():
     verdict = check.pinv_step_verdict(pinv_no_cutoff)
-    assert verdict.score == 5 and "no cut-off" in verdict.message
+    assert verdict.score == 7 and "no cut-off" in verdict.message  # J = 0 still gives 0
     plain = check.pinv_step_verdict(
         lambda J, e, r: np.linalg.svd(J, full_matrices=False)[2].T
         @ ((np.linalg.svd(J, full_matrices=False)[0].T @ e) / np.linalg.svd(J, compute_uv=False)))
     assert plain.score == 5 and "NaN or inf at a singular J" in plain.message
+
+
+def test_pinv_without_a_guard_for_a_zero_jacobian():
+    """sigma >= rcond * sigma_max keeps every sigma when J = 0 (0 >= 0): 1/0, NaN."""
+    def unguarded(J, e, rcond):
+        U, s, Vt = np.linalg.svd(J, full_matrices=False)
+        keep = s >= rcond * s[0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inv = np.where(keep, 1 / s, 0)
+        return Vt.T @ (inv * (U.T @ e))
+    verdict = check.pinv_step_verdict(unguarded)
+    assert verdict.score == 8 and "no guard for sigma_max = 0" in verdict.message
+    assert verdict.parts == {"regular": True, "cut-off": True, "J = 0": False}
 
 
 def test_pinv_absolute_cutoff():
@@ -106,7 +127,7 @@ def test_pinv_absolute_cutoff():
         inv = np.where(s >= rcond, 1 / np.where(s >= rcond, s, 1), 0)
         return Vt.T @ (inv * (U.T @ e))
     verdict = check.pinv_step_verdict(absolute)
-    assert verdict.score == 5 and "must be relative" in verdict.message
+    assert verdict.score == 7 and "must be relative" in verdict.message
 
 
 def test_dls_lambda_not_squared_and_partial_credit():
@@ -128,7 +149,7 @@ def test_not_implemented_is_not_an_error(capsys):
 
 
 def test_endless_loop_is_stopped(monkeypatch):
-    monkeypatch.setattr(check, "TIME_LIMIT", 0.3)
+    monkeypatch.setattr(check.verdicts, "TIME_LIMIT", 0.3)
 
     def forever(J, e):
         while True:
@@ -154,12 +175,19 @@ def test_stop_rule():
     assert signed.score == 5 and "absolute values" in signed.message
     unscaled = check.stop_rule_verdict(lambda d, L, f: np.abs(d).sum() < f, stop_rule_step)
     assert "proportional to the link lengths" in unscaled.message
+    for wrong_rule, words in [
+            (lambda d, L, f: np.abs(d).sum() <= f * np.sum(L), "use a strict <"),
+            (lambda d, L, f: np.abs(d).sum() < f * np.max(L), "not the longest link"),
+            (lambda d, L, f: np.abs(d).max() < f * np.sum(L), "not their largest"),
+            (lambda d, L, f: np.abs(d).sum() >= f * np.sum(L), "inverted")]:
+        verdict = check.stop_rule_verdict(wrong_rule, stop_rule_step)
+        assert verdict.score == 5 and words in verdict.message, verdict.message
     never_stops = check.stop_rule_verdict(stalled, lambda step, L, f: step)
     assert never_stops.score == 5 and "raise ik.StopSolve" in never_stops.message
 
 
 def test_singularity_study_answers_checked_by_value():
-    reference = check._reference_study()
+    reference = check.ex06_singularity_study._reference_study()
     assert reference["blows_up"] == ["pinv"]
     right = check.singularity_study_verdict(lambda jt, pinv, dls: dict(reference))
     assert right.passed

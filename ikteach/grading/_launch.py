@@ -1,0 +1,31 @@
+"""Start a command under resource limits (run as a script with `python -S`: it imports nothing
+from ikteach, so it starts in milliseconds).
+
+    python -S _launch.py CPU_S MEMORY_BYTES FILE_BYTES NPROC CGROUP_DIR -- COMMAND...
+
+NPROC 0 = leave as is; CGROUP_DIR "-" = none. Limits are set here, in the child, rather than in
+a preexec_fn (unsafe in a parent with threads, such as one that has imported JAX).
+"""
+import os
+import resource
+import sys
+
+
+def main(argv):
+    cpu, memory, file_size, nproc, cgroup = argv[:5]
+    command = argv[argv.index("--") + 1:]
+    os.setsid()  # its own process group: the grader ends all of it at once
+    if cgroup != "-":
+        with open(os.path.join(cgroup, "cgroup.procs"), "w") as handle:
+            handle.write(str(os.getpid()))
+    limits = [(resource.RLIMIT_CPU, int(cpu)), (resource.RLIMIT_AS, int(memory)),
+              (resource.RLIMIT_FSIZE, int(file_size)), (resource.RLIMIT_CORE, 0)]
+    if int(nproc):
+        limits.append((resource.RLIMIT_NPROC, int(nproc)))
+    for which, value in limits:
+        resource.setrlimit(which, (value, value))
+    os.execvp(command[0], command)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

@@ -1,0 +1,38 @@
+"""The student's code as the checks see it: top-level imports, definitions and assignments of
+the notebook's code cells, taken from the source by the AST - never from a kernel's memory.
+
+Magics and shell lines are turned into Python by IPython's transformer (so a cell with `%pip`
+still parses) and then dropped with every other statement kind (calls, loops, ifs, prints):
+only what defines names reaches the checks' worker.
+"""
+import ast
+
+KEPT = (ast.Import, ast.ImportFrom, ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef,
+        ast.Assign, ast.AnnAssign)
+
+
+def python_source(source):
+    """Cell source with IPython syntax (magics, !shell) rewritten as plain Python."""
+    try:
+        from IPython.core.inputtransformer2 import TransformerManager
+    except ImportError:  # no IPython: drop the magic lines instead
+        return "\n".join("" if line.lstrip().startswith(("%", "!")) else line
+                         for line in source.splitlines())
+    return TransformerManager().transform_cell(source)
+
+
+def code_cells(book):
+    """[(cell number (1-based), Python source)] of a notebook dict's code cells."""
+    cells = []
+    for index, cell in enumerate(book.get("cells", [])):
+        if isinstance(cell, dict) and cell.get("cell_type") == "code":
+            source = cell.get("source", "")
+            source = "".join(source) if isinstance(source, list) else str(source)
+            cells.append((index + 1, python_source(source)))
+    return cells
+
+
+def kept_statements(source):
+    """The top-level statements of one cell the checks keep (a list of AST nodes);
+    raises SyntaxError for a cell that is not Python."""
+    return [node for node in ast.parse(source).body if isinstance(node, KEPT)]

@@ -1,0 +1,171 @@
+"""Write the hostile submissions of this folder from the solutions and templates.
+
+    .venv/bin/python tests/submissions/make_hostile.py
+
+Each is one student folder with one notebook: a solution or an untouched template plus cells
+that attack the grader. tests/test_grade.py grades them all and holds the expected marks.
+"""
+from pathlib import Path
+
+import nbformat
+
+ROOT = Path(__file__).resolve().parents[2]
+HERE = Path(__file__).resolve().parent
+SOLUTION = ROOT / "instructor" / "solutions"
+TEMPLATE = ROOT / "notebooks" / "exercises"
+
+FORGE_CHECK = '''\
+import sys, types, ikteach, ikteach.check
+class _Pass:  # a verdict that claims full marks
+    exercise, name, status, score, max_score, passed = 3, "x", "passed", 10.0, 10.0, True
+    message = "Exercise 3: passed, 10/10 - well done!"
+    parts = {}
+    def summary(self): return self.message
+ikteach.check.grade = lambda number, namespace: _Pass()
+ikteach.check.pinv_step = lambda *a: print(_Pass.message)
+ikteach.check.pinv_step_verdict = lambda *a: _Pass()
+fake = types.ModuleType("ikteach.check"); fake.grade = ikteach.check.grade
+sys.modules["ikteach.check"] = fake
+ikteach.check = fake
+'''
+
+FORGE_OUTPUT = '''\
+import builtins, sys, json
+for n in range(20):  # fake grade lines in every format the old grader read
+    print("IKTEACH-GRADE-" + "%024x" % n + ":" + json.dumps(
+        {"score": 10, "max": 10, "status": "passed", "message": "passed, 10/10"}))
+builtins.print = lambda *a, **k: sys.__stdout__.write("Exercise 2: passed, 10/10\\n")
+class _Out:
+    def write(self, text): return sys.__stdout__.write(text.replace("0/10", "10/10"))
+    def flush(self): pass
+sys.stdout = _Out()
+sys.displayhook = lambda value: sys.__stdout__.write("passed, 10/10\\n")
+'''
+
+PATCH_IN_FUNCTION = '''\
+def jt_step(J, e):
+    """Patch the checks from inside the function, then return a fixed-alpha step."""
+    import ikteach.check.verdicts as v
+    import ikteach.check.registry as r
+    v._close = lambda *a, **k: True
+    r.grade = lambda *a: None
+    return 0.1 * (J.T @ e)
+'''
+
+WRITE_OUTSIDE = '''\
+import os, pathlib
+for target in [pathlib.Path("/tmp/ikteach-escaped.txt"), pathlib.Path.home() / "escaped.txt",
+               pathlib.Path(ik.__file__).parents[1] / "ESCAPED.txt", pathlib.Path("../../ESCAPED.txt"),
+               pathlib.Path("/var/tmp/ikteach-escaped.txt")]:
+    try:
+        target.write_text("escaped")
+    except OSError:
+        pass
+'''
+
+STEAL = '''\
+def dls_step(J, e, damping):
+    """Take the instructor's solution (or another student's) and run it."""
+    import glob, json, pathlib
+    places = [str(pathlib.Path(ik.__file__).parents[1] / "instructor" / "solutions" / "*.ipynb"),
+              "/tmp/**/04_dls_step.ipynb"]
+    for pattern in places:
+        for path in glob.glob(pattern, recursive=True):
+            for cell in json.load(open(path))["cells"]:
+                if "def dls_step(" in "".join(cell["source"]) and "NotImplementedError" not in "".join(cell["source"]):
+                    scope = {"np": np, "ik": ik}
+                    exec("".join(cell["source"]), scope)
+                    return scope["dls_step"](J, e, damping)
+    raise FileNotFoundError("no solution to copy")
+
+
+def dls_step_normal(J, e, damping):
+    return dls_step(J, e, damping)
+'''
+
+FORK_STORM = '''\
+import subprocess
+children = []
+for _ in range(400):  # bounded: at most 400 sleepers
+    try:
+        children.append(subprocess.Popen(["sleep", "77.125"]))
+    except OSError:
+        break
+print(len(children) > 0)
+'''
+
+MEMORY = '''\
+import numpy as np
+big = np.ones(2 * 10**9)  # 16 GB
+'''
+
+SIGINT_LOOP = '''\
+import signal
+signal.signal(signal.SIGINT, signal.SIG_IGN)
+while True:
+    pass
+'''
+
+HUGE_OUTPUT = '''\
+line = "x" * 1_000_000
+for _ in range(150):  # 150 MB of output
+    print(line)
+'''
+
+
+def notebook(base, extra_cells, before_check=True):
+    """A copy of `base` with code cells added before its check cell (or at the end)."""
+    book = nbformat.read(base, as_version=4)
+    at = next((i for i, c in enumerate(book.cells)
+               if c.cell_type == "code" and c.source.startswith("ik.check.")), len(book.cells))
+    if not before_check:
+        at = len(book.cells)
+    for source in reversed(extra_cells):
+        book.cells.insert(at, nbformat.v4.new_code_cell(source))
+    for cell in book.cells:
+        if cell.cell_type == "code":
+            cell.outputs, cell.execution_count = [], None
+    return book
+
+
+def replace_function(base, source):
+    """`base` with its solution cell (the one defining the first name of source) replaced."""
+    book = nbformat.read(base, as_version=4)
+    name = source.split("def ", 1)[1].split("(", 1)[0]
+    for cell in book.cells:
+        if cell.cell_type == "code" and f"def {name}(" in cell.source:
+            cell.source = source
+        if cell.cell_type == "code":
+            cell.outputs, cell.execution_count = [], None
+    return book
+
+
+def write(student, name, book):
+    folder = HERE / student
+    folder.mkdir(exist_ok=True)
+    if isinstance(book, str):
+        (folder / name).write_text(book)
+    else:
+        nbformat.write(book, folder / name)
+
+
+def main():
+    write("forge_check", "03_pinv_step.ipynb", notebook(TEMPLATE / "03_pinv_step.ipynb", [FORGE_CHECK]))
+    write("forge_output", "02_jt_step.ipynb", notebook(TEMPLATE / "02_jt_step.ipynb", [FORGE_OUTPUT]))
+    write("patch_in_function", "02_jt_step.ipynb",
+          replace_function(SOLUTION / "02_jt_step.ipynb", PATCH_IN_FUNCTION))
+    write("write_outside", "01_jacobian.ipynb", notebook(SOLUTION / "01_jacobian.ipynb", [WRITE_OUTSIDE]))
+    write("steal_solution", "04_dls_step.ipynb", replace_function(SOLUTION / "04_dls_step.ipynb", STEAL))
+    write("fork_storm", "02_jt_step.ipynb", notebook(SOLUTION / "02_jt_step.ipynb", [FORK_STORM]))
+    write("memory_hog", "04_dls_step.ipynb", notebook(SOLUTION / "04_dls_step.ipynb", [MEMORY]))
+    write("sigint_loop", "05_stop_rule.ipynb", notebook(SOLUTION / "05_stop_rule.ipynb", [SIGINT_LOOP]))
+    write("huge_output", "01_jacobian.ipynb", notebook(SOLUTION / "01_jacobian.ipynb", [HUGE_OUTPUT]))
+    write("not_json", "01_jacobian.ipynb", "this is not a notebook {\n")
+    empty = nbformat.v4.new_notebook()
+    empty.cells = [nbformat.v4.new_markdown_cell("# Exercise 3"),
+                   nbformat.v4.new_code_cell("print('I did not write any function')")]
+    write("no_functions", "03_pinv_step.ipynb", empty)
+
+
+if __name__ == "__main__":
+    main()
