@@ -208,11 +208,10 @@ class Demo:
                             damping=self.damping.value, tol=self.tol, max_iter=self.max_iter,
                             clamp=self.clamp)
         self.summary = summary(self.method.value, self.result)
-        self.alt = alt_text(self.arm, target, self.summary)
+        self.alt = alt_text(self.arm, target, self.summary)  # the still's <img alt>
         self.text.value = self.summary
         self.png = self._draw(target)
         self.image.value = self.png
-        self.image.tooltip = self.alt  # ipywidgets' Image has no alt: the title names the <img>
         return self.result
 
     def _draw(self, target):

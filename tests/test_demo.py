@@ -80,7 +80,7 @@ def test_the_image_is_rendered_at_twice_its_css_size_and_changes_with_the_target
     assert demo.image.layout.width == f"{ikdemo.SIZE}px"
     demo.update(x=1.0, y=1.5)
     assert demo.png != before and demo.image.value == demo.png
-    assert "(1.00, 1.50)" in demo.image.tooltip and demo.summary in demo.image.tooltip
+    assert "(1.00, 1.50)" in demo.alt and demo.summary in demo.alt
 
 
 def test_png_writer_round_trips_pixels():
