@@ -9,11 +9,13 @@ SEED = 0
 CACHE_ENV = "IKTEACH_JAX_CACHE"  # a folder for compiled code, or "off"
 
 
-def setup(seed=SEED):
+def setup(seed=SEED, pyvista=None):
     """Round printed numbers, seed the random generators, set plotting defaults.
 
     Returns a numpy Generator seeded with `seed` for the notebook's own random draws.
-    Under test (no display, or PYVISTA_OFF_SCREEN set) pyvista renders off screen.
+    pyvista="static" shows 3-D scenes as PNG images, "interactive" as pyvista's live trame
+    view (needs the `3d` extra); None (default) reads $IKTEACH_PYVISTA, else picks live 3-D
+    when trame is installed and a display is present. Headless, pyvista renders off screen.
     Compiled solvers are kept on disk between runs (see compilation_cache).
     """
     np.set_printoptions(precision=4, suppress=True, floatmode="fixed", linewidth=100)
@@ -31,24 +33,48 @@ def setup(seed=SEED):
         "animation.embed_limit": 4.0,  # MB
         "svg.hashsalt": "ikteach",
     })
-    _setup_pyvista()
+    _setup_pyvista(pyvista)
     compilation_cache()
     return np.random.default_rng(seed)
 
 
-def _setup_pyvista():
+PYVISTA_CHOICES = ("static", "interactive")
+
+
+def pyvista_backend(choice, headless):
+    """The pyvista Jupyter backend wanted for a choice of "static", "interactive" or None
+    (automatic: live 3-D when a display is present, static images headless and under test)."""
+    if choice not in (None, *PYVISTA_CHOICES):
+        raise ValueError(f"pyvista must be one of {PYVISTA_CHOICES} or None, got {choice!r}")
+    if choice is None:
+        return "static" if headless else "trame"
+    return "trame" if choice == "interactive" else "static"
+
+
+def _setup_pyvista(choice=None):
+    """Set pyvista's Jupyter backend (static unless trame is installed); return its name."""
+    choice = choice or os.environ.get("IKTEACH_PYVISTA") or None
+    pyvista_backend(choice, headless=True)  # a bad choice fails before pyvista loads
     try:
         import pyvista as pv
     except ImportError:
-        return
-    headless = not os.environ.get("DISPLAY") or os.environ.get("PYVISTA_OFF_SCREEN")
+        return None
+    headless = not os.environ.get("DISPLAY") or bool(os.environ.get("PYVISTA_OFF_SCREEN"))
     if headless:
         pv.OFF_SCREEN = True
-    try:
-        import trame  # noqa: F401  (live 3-D in Jupyter when available)
-        pv.set_jupyter_backend("static" if headless else "trame")
-    except ImportError:
-        pv.set_jupyter_backend("static")
+    backend = pyvista_backend(choice, headless)
+    if backend == "trame":
+        try:
+            pv.set_jupyter_backend("trame")
+            return "trame"
+        except ImportError:  # no trame: the `3d` extra is not installed
+            if choice == "interactive":
+                import warnings
+
+                warnings.warn("interactive 3-D needs pyvista's trame backend: pip install "
+                              "'ikteach[3d]'; showing static images", stacklevel=3)
+    pv.set_jupyter_backend("static")
+    return "static"
 
 
 def default_cache_dir():

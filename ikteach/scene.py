@@ -1,9 +1,9 @@
 """3-D scenes of an arm with pyvista: links as tubes, joints as short cylinders along their
 axes, frames as axes triads (x red, y green, z blue), the end effector's path as a trail.
 
-Off screen (pv.OFF_SCREEN, set by ik.notebook.setup() when headless) a scene is rendered
-to an image; show() puts that image in the notebook as a PNG, or opens pyvista's live
-view when the user's Jupyter has an interactive backend.
+show() honours the backend chosen with ik.notebook.setup(pyvista="static" | "interactive"):
+static renders off screen to a PNG with alt text; interactive hands the plotter to
+pyvista's trame view (the `3d` extra) in a live kernel.
 """
 import io
 
@@ -16,6 +16,7 @@ COLORS = {"link": "#4c72b0", "joint": "#dd8452", "base": "#555555", "trail": "#c
           "target": "#8172b3"}
 TRIAD_COLORS = ("#d62728", "#2ca02c", "#1f77b4")  # x, y, z
 WINDOW = (480, 360)
+STATIC_BACKENDS = (None, "static", "none")  # pv.global_theme.jupyter_backend values shown as PNG
 
 
 def _pv():
@@ -118,6 +119,7 @@ def scene(arm, theta, target=None, trail=None, window_size=WINDOW, ghost=None, p
             p.add_mesh(mesh, color=COLORS["trail"])
     p.camera_position = _camera(arm, scale)
     p.camera.view_angle = 24.0
+    p._ikteach_alt = describe(arm, theta, target=target, trail=trail, ghost=ghost)
     return p
 
 
@@ -135,18 +137,39 @@ def png_bytes(image):
     return buf.getvalue()
 
 
-def show(plotter):
-    """Show a scene: a static PNG when rendering off screen (tests, CI, a committed notebook),
-    pyvista's interactive view when the user's Jupyter has a live backend."""
+def show(plotter, alt=None):
+    """Show a scene with the backend chosen by ik.notebook.setup(pyvista=...) (or
+    pv.set_jupyter_backend): "static" renders off screen and displays a PNG with alt text
+    (tests, CI, committed notebooks); any live backend ("trame", ...) hands the plotter to
+    pyvista's interactive view. alt defaults to the description scene() attached."""
     pv = _pv()
-    if pv.OFF_SCREEN or pv.global_theme.jupyter_backend in (None, "static", "none"):
+    backend = pv.global_theme.jupyter_backend
+    if backend in STATIC_BACKENDS:
         from IPython.display import Image, display
 
         image = render(plotter)
         plotter.close()
-        display(Image(data=png_bytes(image), format="png"))
+        alt = alt or getattr(plotter, "_ikteach_alt", "A 3-D scene rendered with pyvista.")
+        display(Image(data=png_bytes(image), format="png", alt=alt))
         return None
-    return plotter.show()
+    return plotter.show(jupyter_backend=backend)
+
+
+def describe(arm, theta, target=None, trail=None, ghost=None):
+    """Alt text for a scene: what is drawn and where the end effector is."""
+    _, _, T = frames(arm, theta)
+    words = [f"3-D view of a {arm.n_joints}-joint arm (blue links, orange joints) on a grey floor, "
+             f"end effector at ({T[0, 3]:.2f}, {T[1, 3]:.2f}, {T[2, 3]:.2f}) with its x/y/z "
+             "frame drawn red/green/blue"]
+    if target is not None:
+        t = np.asarray(target, dtype=float)
+        t = t[:3, 3] if t.shape == (4, 4) else np.append(t, 0.0)[:3]
+        words.append(f"a translucent purple target at ({t[0]:.2f}, {t[1]:.2f}, {t[2]:.2f})")
+    if ghost is not None:
+        words.append("the start pose as a translucent ghost")
+    if trail is not None:
+        words.append("the end effector's path as a red trail")
+    return "; ".join(words) + "."
 
 
 def solve_gif(arm, trace_theta, path, target=None, frames_max=30, fps=8, window_size=(320, 240)):

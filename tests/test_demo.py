@@ -3,6 +3,9 @@ import matplotlib
 
 matplotlib.use("Agg")
 
+import base64  # noqa: E402
+import html  # noqa: E402
+
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
@@ -49,3 +52,57 @@ def test_damping_slider_changes_the_dls_solve(demo):
     a = demo.update(x=2.9, y=0.6, method="dls", damping=0.1)
     b = demo.update(damping=1.0)
     assert a.iterations != b.iterations
+
+
+def test_a_preset_button_acts_on_every_click_even_the_same_one_twice(demo):
+    unreachable = next(b for b in demo.preset.children if b.description == "unreachable")
+    unreachable.click()
+    assert (demo.x.value, demo.y.value) == ikdemo.PRESETS["unreachable"]
+    demo.update(x=1.0, y=1.0)
+    unreachable.click()  # the last preset chosen, clicked again: still applies
+    assert (demo.x.value, demo.y.value) == ikdemo.PRESETS["unreachable"]
+    assert demo.result.status == "stalled"
+
+
+def test_an_unknown_preset_name_is_a_value_error_naming_the_presets(demo):
+    with pytest.raises(ValueError, match="preset must be one of"):
+        demo.preset.value = "far away"
+
+
+def test_the_image_is_rendered_at_twice_its_css_size_and_changes_with_the_target(demo):
+    from PIL import Image
+    import io
+
+    demo.update(x=2.5, y=0.5, method="dls")
+    before = demo.png
+    image = Image.open(io.BytesIO(before))
+    assert image.size == (ikdemo.HIDPI * ikdemo.SIZE,) * 2
+    assert demo.image.layout.width == f"{ikdemo.SIZE}px"
+    demo.update(x=1.0, y=1.5)
+    assert demo.png != before and demo.image.value == demo.png
+    assert "(1.00, 1.50)" in demo.alt and demo.summary in demo.alt
+
+
+def test_png_writer_round_trips_pixels():
+    from PIL import Image
+    import io
+
+    rgba = np.random.default_rng(0).integers(0, 256, (7, 5, 4), dtype=np.uint8)
+    back = np.asarray(Image.open(io.BytesIO(ikdemo.png(rgba))).convert("RGB"))
+    np.testing.assert_array_equal(back, rgba[..., :3])
+
+
+def test_displayed_widget_carries_a_still_for_static_pages(demo):
+    demo.update(x=2.9, y=0.6, method="pinv")
+    data, meta = demo.widget._repr_mimebundle_()
+    assert "application/vnd.jupyter.widget-view+json" in data  # live: the widget
+    assert data["text/plain"] == demo.summary                  # static: image + status line
+    assert base64.b64decode(data["image/png"]) == demo.png
+    assert meta["image/png"]["width"] == ikdemo.SIZE
+    page = data["text/html"]
+    assert f'alt="{html.escape(demo.alt)}"' in page and html.escape(demo.summary) in page
+
+
+def test_padded_repeats_the_last_row():
+    out = ikdemo.padded(np.arange(6.0).reshape(3, 2), 5)
+    np.testing.assert_array_equal(out, [[0, 1], [2, 3], [4, 5], [4, 5], [4, 5]])

@@ -1,4 +1,6 @@
 """pyvista scenes: off-screen rendering, image regression against a committed reference."""
+import importlib.util
+
 import numpy as np
 import pytest
 
@@ -58,3 +60,66 @@ def test_solve_gif_writes_frames(tmp_path):
     with Image.open(path) as gif:
         assert gif.n_frames == min(5, len(res.trace.theta))
         assert gif.size == (320, 240)
+
+
+@pytest.fixture
+def backend():
+    """Restore pyvista's backend and off-screen flag after a test that changes them."""
+    pv = pytest.importorskip("pyvista")
+    saved = pv.global_theme.jupyter_backend, pv.OFF_SCREEN
+    yield pv
+    pv.global_theme._jupyter_backend, pv.OFF_SCREEN = saved
+
+
+def _arm_scene():
+    arm = ik.planar_chain([1.0, 1.0, 1.0])
+    return scene.scene(arm, np.array([0.3, 0.2, 0.1]), target=[2.0, 1.0], window_size=(160, 120))
+
+
+def test_static_backend_displays_a_png_with_alt_text(backend, monkeypatch):
+    shown = []
+    monkeypatch.setattr("IPython.display.display", lambda obj: shown.append(obj))
+    ik.notebook.setup(pyvista="static")
+    assert backend.global_theme.jupyter_backend == "static"
+    assert scene.show(_arm_scene()) is None
+    (image,) = shown
+    assert image.data[:4] == b"\x89PNG"
+    assert "3-joint arm" in image.alt and "target at (2.00, 1.00, 0.00)" in image.alt
+
+
+def test_interactive_backend_hands_the_plotter_to_pyvista_even_off_screen(backend, monkeypatch):
+    if importlib.util.find_spec("trame_vtk") is None:  # no `3d` extra: stand in for pyvista
+        monkeypatch.setattr(backend, "set_jupyter_backend",
+                            lambda name: setattr(backend.global_theme, "_jupyter_backend", name))
+    monkeypatch.setenv("PYVISTA_OFF_SCREEN", "true")  # headless, as under test
+    ik.notebook.setup(pyvista="interactive")
+    assert backend.OFF_SCREEN and backend.global_theme.jupyter_backend == "trame"
+    plotter, calls = _arm_scene(), []
+    monkeypatch.setattr(plotter, "show", lambda **kw: calls.append(kw) or "live view")
+    assert scene.show(plotter) == "live view"
+    assert calls == [{"jupyter_backend": "trame"}]
+    plotter.close()
+
+
+def test_interactive_without_trame_warns_and_stays_static(backend, monkeypatch):
+    def no_trame(name):
+        if name != "static":
+            raise ImportError("Please install trame dependencies")
+        backend.global_theme._jupyter_backend = name
+
+    monkeypatch.setattr(backend, "set_jupyter_backend", no_trame)
+    with pytest.warns(UserWarning, match=r"ikteach\[3d\]"):
+        assert ik.notebook._setup_pyvista("interactive") == "static"
+    assert backend.global_theme.jupyter_backend == "static"
+
+
+@pytest.mark.parametrize("choice, headless, expected", [
+    ("static", False, "static"), ("interactive", True, "trame"),
+    (None, True, "static"), (None, False, "trame")])
+def test_pyvista_backend_choice(choice, headless, expected):
+    assert ik.notebook.pyvista_backend(choice, headless) == expected
+
+
+def test_a_bad_pyvista_choice_is_a_value_error_naming_the_parameter():
+    with pytest.raises(ValueError, match="pyvista must be one of"):
+        ik.notebook.setup(pyvista="live")

@@ -1,0 +1,233 @@
+"""A real browser drives JupyterLab through notebook 05: run all, drag the demo, play an animation.
+
+Run with `make test-browser` (it installs Debian's chromium + chromium-driver and selenium);
+not collected by `make test` (the file name does not start with test_). Selenium drives
+/usr/bin/chromium through /usr/bin/chromedriver: nothing is downloaded at run time.
+Screenshots (1280x720) go to $BROWSER_SHOTS (default /tmp/ikteach-browser).
+"""
+import json
+import os
+import re
+import shutil
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from pathlib import Path
+
+import pytest
+
+webdriver = pytest.importorskip("selenium.webdriver")
+from selenium.webdriver.common.action_chains import ActionChains  # noqa: E402
+from selenium.webdriver.common.by import By  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+NOTEBOOK = "05_singularities_out_of_reach.ipynb"
+CHROMIUM, CHROMEDRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
+SHOTS = Path(os.environ.get("BROWSER_SHOTS", "/tmp/ikteach-browser"))
+WIDTH, HEIGHT = 1280, 720
+TOKEN = "ikteach-browser-test"
+RUN_ALL_TIMEOUT = 600  # s: the whole notebook on a busy 2-core machine
+FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+         "--disable-background-networking", "--disable-component-update", "--disable-sync",
+         "--disable-dev-shm-usage", "--hide-scrollbars", "--force-device-scale-factor=1")
+# No news toast over the notebook; a fresh settings folder otherwise.
+# Every cell kept in the page (no windowing), so all prompts and outputs can be found.
+SETTINGS = {"@jupyterlab/apputils-extension/notification.jupyterlab-settings":
+            '{"fetchNews": "false", "checkForUpdates": false}',
+            "@jupyterlab/notebook-extension/tracker.jupyterlab-settings":
+            '{"windowingMode": "none"}'}
+
+
+def _free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _wait_until(condition, timeout, what, every=0.25):
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        value = condition()
+        if value:
+            return value
+        time.sleep(every)
+    raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+
+
+@pytest.fixture(scope="module")
+def lab(tmp_path_factory):
+    """JupyterLab on a free port with a token, serving a copy of notebook 05 (never the repo's)."""
+    home = tmp_path_factory.mktemp("lab")
+    shutil.copy(ROOT / "notebooks" / NOTEBOOK, home / NOTEBOOK)
+    settings = home / ".settings"
+    for name, text in SETTINGS.items():
+        (settings / name).parent.mkdir(parents=True, exist_ok=True)
+        (settings / name).write_text(text)
+    port = _free_port()
+    env = dict(os.environ, PYVISTA_OFF_SCREEN="true", JUPYTER_CONFIG_DIR=str(home / ".config"),
+               JUPYTER_RUNTIME_DIR=str(home / ".runtime"))
+    log = open(home / "lab.log", "w")
+    server = subprocess.Popen(
+        [sys.executable, "-m", "jupyter", "lab", "--no-browser", f"--port={port}",
+         "--ip=127.0.0.1", f"--IdentityProvider.token={TOKEN}", f"--ServerApp.root_dir={home}",
+         f"--LabApp.user_settings_dir={settings}", f"--LabApp.workspaces_dir={home / '.ws'}",
+         "--ServerApp.allow_root=True"],
+        cwd=home, env=env, stdout=log, stderr=subprocess.STDOUT)
+    url = f"http://127.0.0.1:{port}"
+
+    def up():
+        try:
+            return urllib.request.urlopen(f"{url}/api/status?token={TOKEN}", timeout=2).status == 200
+        except OSError:
+            return server.poll() is not None  # died: stop waiting, fail below
+
+    _wait_until(up, 120, "JupyterLab to start")
+    assert server.poll() is None, (home / "lab.log").read_text()[-3000:]
+    yield url
+    server.terminate()
+    server.wait(timeout=30)
+    log.close()
+
+
+@pytest.fixture(scope="module")
+def browser():
+    from selenium.webdriver.chrome.service import Service
+
+    options = webdriver.ChromeOptions()
+    options.binary_location = CHROMIUM
+    for flag in FLAGS:
+        options.add_argument(flag)
+    profile = Path(os.environ.get("TMPDIR", "/tmp")) / f"ikteach-chromium-{os.getpid()}"
+    options.add_argument(f"--user-data-dir={profile}")
+    options.add_argument(f"--window-size={WIDTH},{HEIGHT}")
+    driver = webdriver.Chrome(service=Service(executable_path=CHROMEDRIVER), options=options)
+    driver.set_window_size(WIDTH, HEIGHT)
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    for stale in (*SHOTS.glob("failed-*"), *SHOTS.glob("demo*.png"), *SHOTS.glob("animation*.png")):
+        stale.unlink()
+    yield driver
+    driver.quit()
+    shutil.rmtree(profile, ignore_errors=True)
+
+
+def _kernel_states(lab):
+    """Execution state of each running session's kernel, from the server's REST API."""
+    with urllib.request.urlopen(f"{lab}/api/sessions?token={TOKEN}", timeout=5) as reply:
+        return [s["kernel"]["execution_state"] for s in json.load(reply)]
+
+
+def _shot(driver, name):
+    driver.save_screenshot(str(SHOTS / f"{name}.png"))
+
+
+def _js(driver, script, *args):
+    return driver.execute_script(script, *args)
+
+
+@pytest.fixture(scope="module")
+def notebook(lab, browser):
+    """Notebook 05 open in JupyterLab, all cells run."""
+    try:
+        return _run_all(lab, browser)
+    except Exception:
+        _shot(browser, "failed-run-all")
+        raise
+
+
+def _run_all(lab, browser):
+    browser.get(f"{lab}/lab/tree/{NOTEBOOK}?token={TOKEN}")
+    _wait_until(lambda: browser.find_elements(By.CSS_SELECTOR, ".jp-Notebook .jp-Cell"), 120,
+                "the notebook to open")
+    _wait_until(lambda: _kernel_states(lab) == ["idle"], 180, "the kernel to start")
+    browser.find_element(By.XPATH, "//li[contains(@class,'lm-MenuBar-item')][.='Run']").click()
+    browser.find_element(By.XPATH, "//li[contains(@class,'lm-Menu-item')]"
+                                   "[.//*[normalize-space()='Run All Cells']]").click()
+    cells = json.loads((ROOT / "notebooks" / NOTEBOOK).read_text())["cells"]
+    count = sum(cell["cell_type"] == "code" for cell in cells)
+
+    def finished():  # every code cell numbered ([12]:), none pending ([*]:) or queued ([ ]:)
+        prompts = _js(browser, "return [...document.querySelectorAll('.jp-CodeCell .jp-InputPrompt')]"
+                               ".map(p => p.innerText.trim())")
+        return len(prompts) == count and all(re.fullmatch(r"\[\d+\]:?", p) for p in prompts)
+
+    _wait_until(finished, RUN_ALL_TIMEOUT, "Run All to finish", every=1.0)
+    errors = browser.find_elements(By.CSS_SELECTOR, "[data-mime-type='application/vnd.jupyter.stderr']")
+    tracebacks = [e.text for e in errors if "Traceback" in e.text or "Error" in e.text]
+    assert not tracebacks, tracebacks[0][:2000]
+    return browser
+
+
+def _demo(driver):
+    """The demo's image, status line and x slider handle, scrolled to the top of the page."""
+    try:
+        image = _wait_until(lambda: driver.find_elements(By.CSS_SELECTOR, ".widget-image"), 60,
+                            "the demo widget")[0]
+    except AssertionError:
+        cell = _js(driver, "return [...document.querySelectorAll('.jp-CodeCell')]"
+                           ".find(c => c.innerText.includes('ik.demo.Demo()'))")
+        _js(driver, "arguments[0].scrollIntoView({block: 'start'})", cell)
+        _shot(driver, "failed-demo")
+        for error in cell.find_elements(By.CSS_SELECTOR, ".jupyter-widgets-error-widget"):
+            error.click()  # shows the JavaScript error in place
+        (SHOTS / "failed-demo.html").write_text(cell.get_attribute("outerHTML"))
+        raise
+    _js(driver, "arguments[0].scrollIntoView({block: 'start'})", image)
+    time.sleep(0.5)
+    box = image.find_element(By.XPATH, "./ancestor::div[contains(@class,'widget-hbox')][1]")
+    status = next(lab for lab in box.find_elements(By.CSS_SELECTOR, ".widget-label")
+                  if "iterations" in lab.text)
+    handle = box.find_elements(By.CSS_SELECTOR, ".widget-slider .noUi-handle")[0]
+    return box, image, status, handle
+
+
+def test_demo_is_crisp_and_fits_a_1280x720_screen(notebook):
+    box, image, status, _ = _demo(notebook)
+    _shot(notebook, "demo")
+    css_w, natural_w = _js(notebook, "return [arguments[0].getBoundingClientRect().width,"
+                                     " arguments[0].naturalWidth]", image)
+    assert css_w == 400 and natural_w == 800  # rendered at 2x its CSS size
+    top, bottom, right = _js(notebook, "const r = arguments[0].getBoundingClientRect();"
+                                       " return [r.top, r.bottom, r.right]", box)
+    panel_bottom = _js(notebook, "return document.querySelector('.jp-NotebookPanel .jp-Notebook')"
+                                 ".getBoundingClientRect().bottom")
+    assert 0 <= top and bottom <= panel_bottom <= HEIGHT and right <= WIDTH, (top, bottom, right)
+
+
+def test_moving_the_x_slider_changes_the_status_line_and_the_image(notebook):
+    box, image, status, handle = _demo(notebook)
+    readout = box.find_elements(By.CSS_SELECTOR, ".widget-readout")[0]
+    before = status.text, image.get_attribute("src"), image.screenshot_as_png, readout.text
+    ActionChains(notebook).click_and_hold(handle).move_by_offset(-90, 0).pause(0.3).release().perform()
+    _wait_until(lambda: status.text != before[0], 30, "the status line to change")
+    time.sleep(0.5)
+    _shot(notebook, "demo-after-slider")
+    assert readout.text != before[3]
+    assert image.get_attribute("src") != before[1]
+    assert image.screenshot_as_png != before[2]
+    assert "iterations" in status.text
+
+
+def test_a_preset_button_acts_on_its_first_click(notebook):
+    box, image, status, _ = _demo(notebook)
+    button = box.find_element(By.XPATH, ".//button[normalize-space()='unreachable']")
+    button.click()
+    _wait_until(lambda: "stalled" in status.text, 30, "the unreachable preset to apply")
+    readout = box.find_elements(By.CSS_SELECTOR, ".widget-readout")[0]
+    assert readout.text == "3.50"
+
+
+def test_the_animation_play_button_advances_frames(notebook):
+    slider = _wait_until(lambda: notebook.find_elements(By.CSS_SELECTOR, "input.anim-slider"), 30,
+                         "a jshtml animation")[0]
+    controls = slider.find_element(By.XPATH, "./ancestor::div[contains(@class,'animation')][1]")
+    _js(notebook, "arguments[0].scrollIntoView({block: 'center'})", slider)
+    controls.find_element(By.CSS_SELECTOR, "button[title='First frame']").click()
+    frame0 = int(slider.get_attribute("value"))
+    picture = controls.find_element(By.TAG_NAME, "img").get_attribute("src")
+    controls.find_element(By.CSS_SELECTOR, "button[title='Play']").click()
+    time.sleep(0.2)
+    _shot(notebook, "animation-playing")
+    _wait_until(lambda: int(slider.get_attribute("value")) > frame0, 10, "the animation to advance")
+    assert controls.find_element(By.TAG_NAME, "img").get_attribute("src") != picture
