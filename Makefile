@@ -7,15 +7,19 @@ UV := $(VENV)/bin/uv
 UV_VERSION ?= 0.13.9
 STAMP := $(VENV)/.installed-stamp
 # uv installs into $(VENV), never downloads a Python of its own, and keeps the venv's pip.
+# --locked: stop with "run make lock" when pyproject.toml has changed since uv.lock.
 export UV_PROJECT_ENVIRONMENT := $(VENV)
 export UV_PYTHON_DOWNLOADS := never
-SYNC := $(UV) sync --frozen --inexact --extra dev
+SYNC := $(UV) sync --locked --inexact --extra dev
 
 .PHONY: lab test test-latest lock lock-upgrade header notebooks strip bench clean exercises
 
-$(STAMP): pyproject.toml uv.lock
+# uv itself comes from PyPI, into the venv (the lock then keeps it at its locked version).
+$(UV):
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	@test -x $(UV) || $(PY) -m pip install --quiet uv==$(UV_VERSION)
+	$(PY) -m pip install --quiet uv==$(UV_VERSION)
+
+$(STAMP): pyproject.toml uv.lock | $(UV)
 	$(SYNC) --quiet
 	@touch $(STAMP)
 
@@ -44,11 +48,11 @@ test-latest: $(STAMP)
 # After editing dependencies in pyproject.toml: record them in uv.lock (other pins unchanged).
 # Once a semester (before it starts): `make lock-upgrade` moves every pin to the newest allowed.
 # Both rewrite binder/constraints.txt, Binder's copy of the lock.
-lock: $(STAMP)
+lock: | $(UV)
 	$(UV) lock
 	$(MAKE) binder/constraints.txt
 
-lock-upgrade: $(STAMP)
+lock-upgrade: | $(UV)
 	$(UV) lock --upgrade
 	$(MAKE) binder/constraints.txt
 

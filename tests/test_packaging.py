@@ -109,7 +109,7 @@ def test_ci_runs_the_readme_test_command():
 
 def test_make_installs_from_the_lock():
     makefile = (ROOT / "Makefile").read_text()
-    assert re.search(r"sync --frozen", makefile)
+    assert re.search(r"sync --locked", makefile)
     for target in ("lab:", "test:", "test-latest:", "lock:"):
         assert re.search(rf"^{target}", makefile, re.M), target
 
