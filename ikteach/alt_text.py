@@ -8,23 +8,36 @@ text made of its titles and axis labels; the text/plain fallback carries the sam
 import base64
 import html
 import io
+import re
 
 MAX_ALT = 300  # characters: a screen reader reads all of it
 
 
+def plain(text):
+    """Mathtext and line breaks made readable: '$\\alpha^*$\\nstep' -> 'alpha^* step'."""
+    text = re.sub(r"\\(?:mathrm|mathbf|mathit|text|operatorname)\{([^}]*)\}", r"\1", text)
+    text = re.sub(r"\\top\b", "T", text)
+    text = re.sub(r"\\([A-Za-z]+)", r"\1", text)
+    text = text.replace("\\|", "‖")
+    return " ".join(text.replace("$", "").replace("{", "").replace("}", "").split())
+
+
 def _axes_text(ax):
-    """'title (y label against x label)' for one axes, or '' when it says nothing."""
+    """'title (y label against x label; legend: a, b)' for one axes, or '' when it says nothing."""
     title = " ".join(t for t in (ax.get_title("left"), ax.get_title(), ax.get_title("right")) if t)
     x, y = ax.get_xlabel(), ax.get_ylabel()
-    axes = f"{y} against {x}" if x and y else (x or y)
-    if title and axes:
-        return f"{title} ({axes})"
-    return title or axes
+    details = [f"{y} against {x}" if x and y else (x or y)]
+    legend = ax.get_legend()
+    if legend is not None:
+        details.append("legend: " + ", ".join(t.get_text() for t in legend.get_texts()))
+    details = "; ".join(d for d in details if d)
+    text = f"{title} ({details})" if title and details else (title or details)
+    return plain(text)
 
 
 def figure_alt(fig):
     """One line describing a figure from its suptitle, axes titles and axis labels."""
-    suptitle = fig._suptitle.get_text() if getattr(fig, "_suptitle", None) else ""
+    suptitle = plain(fig._suptitle.get_text()) if getattr(fig, "_suptitle", None) else ""
     panels = [t for t in (_axes_text(ax) for ax in fig.axes) if t]
     n = len(fig.axes)
     lead = suptitle or ("Figure" if n <= 1 else f"Figure with {n} panels")

@@ -140,11 +140,13 @@ def show(plotter):
     pyvista's interactive view when the user's Jupyter has a live backend."""
     pv = _pv()
     if pv.OFF_SCREEN or pv.global_theme.jupyter_backend in (None, "static", "none"):
-        from IPython.display import Image, display
+        from IPython.display import HTML, display
+
+        from .alt_text import img_html
 
         image = render(plotter)
         plotter.close()
-        display(Image(data=png_bytes(image), format="png"))
+        display(HTML(img_html(png_bytes(image), "3-D view of the arm (static pyvista image)")))
         return None
     return plotter.show()
 
