@@ -7,7 +7,8 @@ nothing in git.
 Noise is what differs between two runs of the same notebook with the same versions:
 per-cell execution timestamps, saved widget state and the random widget model ids that
 point into it, the kernel's exact Python version, Lab's view flags (collapsed, scrolled),
-and the random element ids of matplotlib's JavaScript animations (made stable here: a hash
+how a stream was split into outputs (merged into one per run of stdout/stderr), and the
+random element ids of matplotlib's JavaScript animations (made stable here: a hash
 of the animation's own HTML). Outputs that carry results are kept as they are.
 """
 import argparse
@@ -51,6 +52,20 @@ def _strip_output(output):
     return output
 
 
+def _merge_streams(outputs):
+    """Consecutive stdout (or stderr) outputs as one: how a run splits them depends on timing."""
+    merged = []
+    for output in outputs:
+        last = merged[-1] if merged else None
+        if (last is not None and output.get("output_type") == "stream" == last.get("output_type")
+                and output.get("name") == last.get("name")):
+            text = "".join(last["text"]) + "".join(output["text"])
+            last["text"] = text.splitlines(keepends=True)
+        else:
+            merged.append(output)
+    return merged
+
+
 def strip_notebook(nb):
     """Remove run noise from a notebook (a dict or nbformat node), in place; returns it."""
     meta = nb.get("metadata", {})
@@ -63,7 +78,7 @@ def strip_notebook(nb):
         if cell.get("metadata", {}).get("jupyter") == {}:
             del cell["metadata"]["jupyter"]
         if cell.get("cell_type") == "code":
-            cell["outputs"] = [_strip_output(o) for o in cell.get("outputs", [])]
+            cell["outputs"] = _merge_streams([_strip_output(o) for o in cell.get("outputs", [])])
     return nb
 
 
@@ -79,7 +94,10 @@ def noise(nb):
         keys = [k for k in CELL_NOISE if k in cell.get("metadata", {})]
         if keys:
             found.append(f"cell {i}: metadata {', '.join(keys)}")
-        for output in cell.get("outputs", []):
+        outputs = cell.get("outputs", [])
+        if len(_merge_streams(json.loads(json.dumps(outputs)))) != len(outputs):
+            found.append(f"cell {i}: one stream split into several outputs")
+        for output in outputs:
             before = json.dumps(output, sort_keys=True)
             after = json.dumps(_strip_output(json.loads(before)), sort_keys=True)
             if before != after:

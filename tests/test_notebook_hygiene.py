@@ -115,7 +115,8 @@ def _noisy_notebook():
                                               "version_minor": 0}}},
                                {"output_type": "display_data", "metadata": {},
                                 "data": {"text/html": [html]}},
-                               {"output_type": "stream", "name": "stdout", "text": ["17 iterations\n"]}],
+                               {"output_type": "stream", "name": "stdout", "text": ["17 iterations\n"]},
+                               {"output_type": "stream", "name": "stdout", "text": ["converged\n"]}],
                    "source": ["demo"]}],
         "metadata": {"language_info": {"name": "python", "version": "3.11.7"},
                      "widgets": {"application/vnd.jupyter.widget-state+json": {"state": {}}}},
@@ -124,13 +125,14 @@ def _noisy_notebook():
 
 def test_strip_removes_run_noise_and_keeps_results():
     nb = _noisy_notebook()
-    assert len(notebook_strip.noise(nb)) == 4
+    assert len(notebook_strip.noise(nb)) == 5
     notebook_strip.strip_notebook(nb)
     assert notebook_strip.noise(nb) == []
     cell = nb["cells"][0]
     assert cell["metadata"] == {"tags": ["keep-me"]}
     assert cell["outputs"][0]["data"] == {"text/plain": ["VBox()"]}
-    assert cell["outputs"][2]["text"] == ["17 iterations\n"]
+    assert cell["outputs"][2]["text"] == ["17 iterations\n", "converged\n"]  # one stream
+    assert len(cell["outputs"]) == 3
     assert nb["metadata"] == {"language_info": {"name": "python"}}
     html = "".join(cell["outputs"][1]["data"]["text/html"])
     assert "0f1e2d3c4b5a49788a7b6c5d4e3f2a1b" not in html
