@@ -1,15 +1,26 @@
 # Two commands: `make lab` opens the course, `make test` runs every test.
+# Both install from the lock file (uv.lock): the same versions every semester.
 PYTHON ?= python3
 VENV ?= .venv
 PY := $(VENV)/bin/python
+UV := $(VENV)/bin/uv
+UV_VERSION ?= 0.13.9
 STAMP := $(VENV)/.installed-stamp
+# uv installs into $(VENV), never downloads a Python of its own, and keeps the venv's pip.
+# --locked: stop with "run make lock" when pyproject.toml has changed since uv.lock.
+export UV_PROJECT_ENVIRONMENT := $(VENV)
+export UV_PYTHON_DOWNLOADS := never
+SYNC := $(UV) sync --locked --inexact --extra dev
 
-.PHONY: lab test bench clean exercises test-browser
+.PHONY: lab test test-latest lock lock-upgrade header notebooks strip bench clean exercises test-browser
 
-$(STAMP): pyproject.toml
+# uv itself comes from PyPI, into the venv (the lock then keeps it at its locked version).
+$(UV):
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e ".[dev]"
+	$(PY) -m pip install --quiet uv==$(UV_VERSION)
+
+$(STAMP): pyproject.toml uv.lock | $(UV)
+	$(SYNC) --quiet
 	@touch $(STAMP)
 
 # Jupyter refuses to run as root unless told (containers, Binder-like machines).
@@ -18,24 +29,67 @@ LAB_ARGS ?= $(if $(filter 0,$(shell id -u)),--allow-root)
 lab: $(STAMP)
 	$(VENV)/bin/jupyter lab --notebook-dir=notebooks $(LAB_ARGS)
 
-test: $(STAMP)
-	$(PY) -m pytest -n 2 --dist loadfile tests $(wildcard notebooks/*.ipynb) $(EXERCISES) --nbval --nbval-sanitize-with tests/nbval_sanitize.cfg
-
 # Exercise templates (check cells print "not yet implemented") and the instructor's solutions.
 EXERCISES = $(wildcard notebooks/exercises/*.ipynb) $(wildcard instructor/solutions/*.ipynb)
+NOTEBOOKS = $(wildcard notebooks/*.ipynb) $(EXERCISES)
+PYTEST_ARGS = -n 2 --dist loadfile tests $(NOTEBOOKS) --nbval --nbval-sanitize-with tests/nbval_sanitize.cfg
+
+test: $(STAMP)
+	$(PY) -m pytest $(PYTEST_ARGS)
+
+# The same suite against the newest versions pyproject.toml allows (not the lock), in its own
+# venv: run it before `make lock-upgrade`, to see what a refreshed lock would change.
+LATEST_VENV ?= .venv-latest
+test-latest: $(STAMP)
+	@test -x $(LATEST_VENV)/bin/python || $(UV) venv --quiet --python $(PY) $(LATEST_VENV)
+	$(UV) pip install --quiet --python $(LATEST_VENV)/bin/python --upgrade -e ".[dev]"
+	$(LATEST_VENV)/bin/python -m pytest $(PYTEST_ARGS)
+
+# After editing dependencies in pyproject.toml: record them in uv.lock (other pins unchanged).
+# Once a semester (before it starts): `make lock-upgrade` moves every pin to the newest allowed.
+# Both rewrite binder/constraints.txt, Binder's copy of the lock.
+lock: | $(UV)
+	$(UV) lock
+	$(MAKE) binder/constraints.txt
+
+lock-upgrade: | $(UV)
+	$(UV) lock --upgrade
+	$(MAKE) binder/constraints.txt
+
+binder/constraints.txt: uv.lock
+	$(UV) export --quiet --frozen --no-hashes --no-emit-project --extra lab --extra 3d \
+		--no-header -o $@
+
+# The course's public home (pyproject.toml [project.urls]) -> every notebook's first code cell
+# and the Colab/Binder badges in README.md and notebooks/README.md.
+header: $(STAMP)
+	$(PY) -m ikteach.notebook_header
+
+# Strip run noise (timestamps, widget state, kernel versions) from every committed notebook.
+strip: $(STAMP)
+	$(PY) -m ikteach.notebook_strip $(NOTEBOOKS)
+
+# Re-execute every notebook with the locked versions, then strip: what to commit.
+notebooks: $(STAMP)
+	$(PY) -m ikteach.notebook_header
+	$(PY) -m ikteach.exercises build
+	@for nb in notebooks/*.ipynb instructor/solutions/*.ipynb; do echo "== $$nb"; \
+		$(VENV)/bin/jupyter nbconvert --to notebook --execute --inplace \
+			--ExecutePreprocessor.timeout=900 $$nb || exit 1; done
+	$(PY) -m ikteach.notebook_strip $(NOTEBOOKS)
 
 exercises: $(STAMP)
 	$(PY) -m ikteach.exercises build
 
 clean:
-	rm -rf $(VENV) .pytest_cache .hypothesis
+	rm -rf $(VENV) $(LATEST_VENV) .pytest_cache .hypothesis
 
 # Benchmarks print tables (never part of make test). The peer libraries of the bench extra
 # go into their own venv, so that they never change what the tests run against.
 BENCH_VENV ?= .venv-bench
-bench:
-	@test -x $(BENCH_VENV)/bin/python || $(PYTHON) -m venv $(BENCH_VENV)
-	$(BENCH_VENV)/bin/python -m pip install --quiet -e ".[dev,bench]"
+bench: $(STAMP)
+	@test -x $(BENCH_VENV)/bin/python || $(UV) venv --quiet --python $(PY) $(BENCH_VENV)
+	UV_PROJECT_ENVIRONMENT=$(BENCH_VENV) $(UV) sync --frozen --quiet --extra dev --extra bench
 	@for b in benchmarks/*.py; do echo "== $$b"; $(BENCH_VENV)/bin/python $$b || exit 1; done
 
 # A real browser (Debian's chromium + chromium-driver, driven by selenium) runs notebook 05 in

@@ -14,6 +14,8 @@ import re
 import sys
 from pathlib import Path
 
+from .notebook_strip import strip_notebook
+
 BEGIN = "### BEGIN SOLUTION"
 END = "### END SOLUTION"
 PLACEHOLDER = 'raise NotImplementedError("replace this line with your code")'
@@ -90,6 +92,7 @@ def build(solutions=SOLUTIONS, out=TEMPLATES, run=True):
         book = template_from(nbformat.read(path, as_version=4))
         if run:
             execute(book, out)
+        strip_notebook(book)  # no run noise in the committed template
         target = out / path.name
         nbformat.write(book, target)
         written.append(target)

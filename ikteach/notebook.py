@@ -35,7 +35,39 @@ def setup(seed=SEED, pyvista=None):
     })
     _setup_pyvista(pyvista)
     compilation_cache()
+    _setup_alt_text()
+    print_versions()
     return np.random.default_rng(seed)
+
+
+def versions_line():
+    """'versions: ikteach X, jax X, numpy X, python X' (nbval's sanitizer hides the numbers)."""
+    import platform
+
+    import jax
+
+    from . import __version__
+
+    return (f"versions: ikteach {__version__}, jax {jax.__version__}, numpy {np.__version__}, "
+            f"python {platform.python_version()}")
+
+
+def print_versions():
+    """Print one line of versions, so every executed notebook records what it ran with."""
+    print(versions_line())
+
+
+def _setup_alt_text():
+    """In a notebook, matplotlib figures display with alt text (see ikteach.alt_text)."""
+    try:
+        from IPython import get_ipython
+    except ImportError:
+        return
+    shell = get_ipython()
+    if shell is not None and hasattr(shell, "display_formatter"):
+        from . import alt_text
+
+        alt_text.register(shell)
 
 
 PYVISTA_CHOICES = ("static", "interactive")

@@ -299,11 +299,14 @@ def still_png(anim, frame=None):
 
 
 def show(anim, frame=None):
-    """Display an animation in a notebook: first its still frame as a PNG (readable where
-    scripts do not run, e.g. on GitHub), then the playable JavaScript animation."""
-    from IPython.display import HTML, Image, display
+    """Display an animation in a notebook: first its still frame as a PNG with alt text
+    (readable where scripts do not run, e.g. on GitHub), then the playable JavaScript."""
+    from IPython.display import HTML, display
 
-    display(Image(still_png(anim, frame)))
+    from .alt_text import figure_alt, img_html
+
+    png = still_png(anim, frame)
+    display(HTML(img_html(png, "Still frame of an animation. " + figure_alt(anim._fig))))
     display(HTML(anim.to_jshtml(default_mode="once")))
 
 

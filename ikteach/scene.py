@@ -145,12 +145,14 @@ def show(plotter, alt=None):
     pv = _pv()
     backend = pv.global_theme.jupyter_backend
     if backend in STATIC_BACKENDS:
-        from IPython.display import Image, display
+        from IPython.display import HTML, display
+
+        from .alt_text import img_html
 
         image = render(plotter)
         plotter.close()
         alt = alt or getattr(plotter, "_ikteach_alt", "A 3-D scene rendered with pyvista.")
-        display(Image(data=png_bytes(image), format="png", alt=alt))
+        display(HTML(img_html(png_bytes(image), alt)))
         return None
     return plotter.show(jupyter_backend=backend)
 

@@ -1,0 +1,209 @@
+"""Committed notebooks: the generated first cell, no run noise, alt text on every matplotlib
+figure; setup() prints its versions line."""
+import base64
+import json
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+
+from ikteach import alt_text, course_home, notebook, notebook_header, notebook_strip
+
+ROOT = Path(__file__).resolve().parents[1]
+NOTEBOOKS = notebook_header.notebook_paths(ROOT)
+HOME = course_home.home(ROOT / "pyproject.toml")
+
+
+def _load(path):
+    return json.loads(Path(path).read_text(encoding="utf-8"))
+
+
+def _first_code(nb):
+    cell = next(c for c in nb["cells"] if c["cell_type"] == "code")
+    return "".join(cell["source"])
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.relative_to(ROOT).as_posix())
+def test_first_code_cell_is_generated_from_the_course_home(path):
+    source = _first_code(_load(path))
+    assert source.startswith(notebook_header.header(HOME)), \
+        f"{path.name}: first cell out of date, run `make header`"
+    assert HOME.requirement in source
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.relative_to(ROOT).as_posix())
+def test_no_run_noise(path):
+    assert notebook_strip.noise(_load(path)) == [], f"run `make strip` on {path.name}"
+
+
+def test_badges_and_headers_are_up_to_date():
+    assert notebook_header.update(ROOT, write=False) == [], "run `make header`"
+    text = (ROOT / "notebooks" / "README.md").read_text(encoding="utf-8")
+    assert notebook_header.missing_rows(text, ROOT) == []
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    for path in NOTEBOOKS:
+        rel = path.relative_to(ROOT).as_posix()
+        if not rel.startswith("instructor/"):
+            assert HOME.colab_url(rel) in readme and HOME.binder_url(rel) in readme
+
+
+def _copy_course(tmp_path):
+    for rel in ("pyproject.toml", "README.md", "notebooks", "instructor"):
+        src = ROOT / rel
+        (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp_path / rel)
+    return tmp_path
+
+
+def _new_notebook(path, first_source):
+    nb = {"cells": [{"cell_type": "markdown", "metadata": {}, "source": ["# New"]},
+                    {"cell_type": "code", "execution_count": None, "metadata": {}, "outputs": [],
+                     "source": [first_source]}],
+          "metadata": {}, "nbformat": 4, "nbformat_minor": 5}
+    path.write_text(json.dumps(nb), encoding="utf-8")
+
+
+def test_header_is_added_to_a_new_notebook_and_idempotent(tmp_path):
+    root = _copy_course(tmp_path)
+    new = root / "notebooks" / "09_new.ipynb"
+    _new_notebook(new, "import ikteach as ik\nrng = ik.notebook.setup()")
+    readme = root / "notebooks" / "README.md"
+    readme.write_text(readme.read_text().replace("|---|---|\n", "|---|---|\n| `09_new.ipynb` | new |\n", 1))
+    changed = notebook_header.update(root)
+    assert new in changed and root / "README.md" in changed
+    source = _first_code(_load(new))
+    assert source == notebook_header.header(HOME) + "import ikteach as ik\nrng = ik.notebook.setup()"
+    assert HOME.colab_url("notebooks/09_new.ipynb") in readme.read_text()
+    assert notebook_header.update(root) == []  # a second run changes nothing
+
+
+def test_header_follows_a_new_home(tmp_path):
+    root = _copy_course(tmp_path)
+    pyproject = root / "pyproject.toml"
+    pyproject.write_text(pyproject.read_text().replace("YOUR-ORG/ikteach", "a-school/ik-course"))
+    notebook_header.update(root)
+    home = course_home.home(pyproject)
+    for path in notebook_header.notebook_paths(root):
+        source = _first_code(_load(path))
+        assert source.count("%pip install") == 1
+        assert '"ikteach @ git+https://github.com/a-school/ik-course@main"' in source
+    assert "github.com/YOUR-ORG" not in (root / "README.md").read_text()
+    assert home.binder_url("notebooks/01_jacobian.ipynb") in (root / "notebooks" / "README.md").read_text()
+
+
+def test_a_hand_edited_header_fails_the_check(tmp_path):
+    root = _copy_course(tmp_path)
+    path = notebook_header.notebook_paths(root)[0]
+    nb = _load(path)
+    cell = next(c for c in nb["cells"] if c["cell_type"] == "code")
+    cell["source"] = ["".join(cell["source"]).replace("--quiet ", "")]
+    path.write_text(json.dumps(nb), encoding="utf-8")
+    assert path in notebook_header.update(root, write=False)
+
+
+def _noisy_notebook():
+    html = ('<img id="_anim_img0f1e2d3c4b5a49788a7b6c5d4e3f2a1b">'
+            '<script>var anim0f1e2d3c4b5a49788a7b6c5d4e3f2a1b = 1;</script>')
+    return {
+        "cells": [{"cell_type": "code", "execution_count": 1, "id": "abc",
+                   "metadata": {"execution": {"iopub.status.busy": "2026-11-22T01:00:00Z"},
+                                "scrolled": True, "tags": ["keep-me"]},
+                   "outputs": [{"output_type": "display_data", "metadata": {},
+                                "data": {"text/plain": ["VBox()"],
+                                         "application/vnd.jupyter.widget-view+json":
+                                             {"model_id": "d166e049", "version_major": 2,
+                                              "version_minor": 0}}},
+                               {"output_type": "display_data", "metadata": {},
+                                "data": {"text/html": [html]}},
+                               {"output_type": "stream", "name": "stdout", "text": ["17 iterations\n"]},
+                               {"output_type": "stream", "name": "stdout", "text": ["converged\n"]}],
+                   "source": ["demo"]}],
+        "metadata": {"language_info": {"name": "python", "version": "3.11.7"},
+                     "widgets": {"application/vnd.jupyter.widget-state+json": {"state": {}}}},
+        "nbformat": 4, "nbformat_minor": 5}
+
+
+def test_strip_removes_run_noise_and_keeps_results():
+    nb = _noisy_notebook()
+    assert len(notebook_strip.noise(nb)) == 5
+    notebook_strip.strip_notebook(nb)
+    assert notebook_strip.noise(nb) == []
+    cell = nb["cells"][0]
+    assert cell["metadata"] == {"tags": ["keep-me"]}
+    assert cell["outputs"][0]["data"] == {"text/plain": ["VBox()"]}
+    assert cell["outputs"][2]["text"] == ["17 iterations\n", "converged\n"]  # one stream
+    assert len(cell["outputs"]) == 3
+    assert nb["metadata"] == {"language_info": {"name": "python"}}
+    html = "".join(cell["outputs"][1]["data"]["text/html"])
+    assert "0f1e2d3c4b5a49788a7b6c5d4e3f2a1b" not in html
+    new_id = re.search(r"_anim_img([0-9a-f]{32})", html).group(1)
+    assert f"var anim{new_id} = 1" in html  # every use of one id gets the same new id
+
+
+def test_strip_is_deterministic_and_idempotent(tmp_path):
+    a, b = _noisy_notebook(), _noisy_notebook()
+    b["cells"][0]["outputs"][1]["data"]["text/html"] = [
+        b["cells"][0]["outputs"][1]["data"]["text/html"][0].replace(
+            "0f1e2d3c4b5a49788a7b6c5d4e3f2a1b", "99999999999940008000aaaaaaaaaaaa")]
+    assert notebook_strip.strip_notebook(a) == notebook_strip.strip_notebook(b)  # another run
+    path = tmp_path / "nb.ipynb"
+    path.write_text(json.dumps(_noisy_notebook()))
+    assert notebook_strip.strip_file(path) is True
+    assert notebook_strip.strip_file(path) is False
+
+
+def _images(nb):
+    """(cell index, PNG bytes, alt or None) for each PNG image in the outputs."""
+    for i, cell in enumerate(nb["cells"]):
+        for output in cell.get("outputs", []):
+            data = output.get("data", {})
+            if "image/png" in data:
+                png = base64.b64decode("".join(data["image/png"]))
+                alt = output.get("metadata", {}).get("image/png", {}).get("alt")
+                yield i, png, alt
+            html = "".join(data.get("text/html", []))
+            for m in re.finditer(r'<img (?:alt="([^"]*)" )?src="data:image/png;base64,([^"]+)"', html):
+                yield i, base64.b64decode(m.group(2)), m.group(1)
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.relative_to(ROOT).as_posix())
+def test_every_image_has_alt_text(path):
+    images = list(_images(_load(path)))
+    for i, png, alt in images:
+        assert png.startswith(b"\x89PNG")
+        assert alt, f"{path.name} cell {i}: an image without alt text"
+
+
+def test_figure_alt_text_is_made_of_titles_and_labels():
+    from matplotlib.figure import Figure
+
+    fig = Figure()
+    ax1, ax2 = fig.subplots(1, 2)
+    fig.suptitle("DLS against λ")
+    ax1.set(title="error", xlabel="iteration", ylabel="|e|")
+    ax2.set_title("joint angles")
+    assert alt_text.figure_alt(fig) == "DLS against λ: error (|e| against iteration); joint angles"
+    html = alt_text.figure_html(fig)
+    assert html.startswith('<img alt="DLS against λ: error (|e| against iteration); joint angles" ')
+    png = base64.b64decode(re.search(r"base64,([^\"]+)", html).group(1))
+    assert png.startswith(b"\x89PNG") and b"Matplotlib" in png[:400]
+    assert alt_text.figure_alt(Figure()) == "Figure"
+    assert alt_text.img_html(b"x", 'a "quoted" <b>').startswith('<img alt="a &quot;quoted&quot; &lt;b&gt;"')
+
+
+def test_setup_prints_one_versions_line(capsys):
+    import platform
+
+    import jax
+    import numpy as np
+
+    import ikteach
+
+    notebook.setup()
+    lines = capsys.readouterr().out.splitlines()
+    assert lines == [f"versions: ikteach {ikteach.__version__}, jax {jax.__version__}, "
+                     f"numpy {np.__version__}, python {platform.python_version()}"]
+    # nbval compares it with the numbers replaced (tests/nbval_sanitize.cfg).
+    cfg = (ROOT / "tests" / "nbval_sanitize.cfg").read_text()
+    regex = re.search(r"\[versions line\]\nregex: (.*)\nreplace: (.*)", cfg)
+    assert re.sub(regex.group(1), regex.group(2), lines[0]) == "versions: VERSIONS"

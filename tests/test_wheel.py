@@ -1,0 +1,165 @@
+"""The built package works outside the checkout: wheel and sdist from a copy of the source
+(plus a probe data file, to show that new package data is shipped), the wheel installed into
+a clean venv in a temporary folder, then a solve, a plot and an off-screen pyvista scene run
+from there. A second venv stands in for Colab: Colab's preinstalled jax, numpy, matplotlib
+and ipywidgets first, then the wheel, which must leave them as they are.
+
+uv does the builds and installs (from its cache after the first run; pins from the lock).
+"""
+import os
+import shutil
+import subprocess
+import sys
+import tarfile
+import zipfile
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PROBE = "data/_probe_for_tests.txt"
+
+# Colab's preinstalled versions (Python 3.12): numpy 2.0.2 and matplotlib 3.10.0 from a
+# listing of Colab's runtime (2026-02); jax 0.5.2 from Colab's announced upgrade
+# (googlecolab/colabtools#5164, with jaxlib 0.5.1); ipywidgets 7.7.1 from Colab's pip freeze
+# (googlecolab/backend-info). Update them when Colab moves.
+COLAB_PYTHON = "3.12"
+COLAB = {"jax": "0.5.2", "jaxlib": "0.5.1", "numpy": "2.0.2", "matplotlib": "3.10.0",
+         "ipywidgets": "7.7.1"}
+
+SMOKE = r'''
+import importlib.resources, sys
+from pathlib import Path
+import numpy as np
+import ikteach as ik
+
+assert not Path(ik.__file__).resolve().is_relative_to(Path(sys.argv[1])), ik.__file__
+arm = ik.planar_chain([1.0, 1.0, 1.0])
+res = ik.solve(arm, np.array([2.0, 1.0]), np.zeros(3), method="dls", damping=0.5)
+assert res.status == "converged", res.status
+print("solve:", res.status, res.iterations)
+
+import matplotlib
+matplotlib.use("Agg")
+from matplotlib.figure import Figure
+fig = Figure()
+ax = fig.subplots()
+ik.plot.draw_arm(ax, arm, res.theta)
+fig.savefig("arm.png")
+assert Path("arm.png").stat().st_size > 1000
+print("plot: arm.png")
+
+if "--scene" in sys.argv:
+    import pyvista as pv
+    pv.OFF_SCREEN = True
+    ur5 = ik.ur5()
+    p = ik.scene.scene(ur5, np.zeros(6))
+    image = ik.scene.render(p)
+    p.close()
+    assert image.ndim == 3 and image.std() > 1.0, "blank scene"
+    print("scene:", image.shape)
+
+if "--probe" in sys.argv:
+    print("data:", importlib.resources.files("ikteach").joinpath(sys.argv[-1]).read_text().strip())
+
+if "--demo" in sys.argv:
+    demo = ik.demo.Demo()
+    demo.update(x=3.5, y=1.0)
+    import ipywidgets
+    print("demo:", ipywidgets.__version__, demo.result.status)
+'''
+
+
+def _uv(*args, **kw):
+    return subprocess.run([sys.executable, "-m", "uv", *args], check=True, capture_output=True,
+                          text=True, env={**os.environ, "UV_PYTHON_DOWNLOADS": "never"}, **kw)
+
+
+def _run(python, *args, cwd):
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
+    env["PYVISTA_OFF_SCREEN"] = "true"
+    return subprocess.run([str(python), *args], cwd=cwd, check=True, capture_output=True,
+                          text=True, env=env, timeout=600)
+
+
+@pytest.fixture(scope="module")
+def dist(tmp_path_factory):
+    """wheel and sdist built from a copy of the source with a probe data file added."""
+    tmp = tmp_path_factory.mktemp("build")
+    src = tmp / "src"
+    src.mkdir()
+    for name in ("pyproject.toml", "README.md"):
+        shutil.copy(ROOT / name, src / name)
+    shutil.copytree(ROOT / "ikteach", src / "ikteach",
+                    ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    (src / "ikteach" / PROBE).parent.mkdir(exist_ok=True)
+    (src / "ikteach" / PROBE).write_text("probe data file\n")
+    _uv("build", "--quiet", "--sdist", "--wheel", "--out-dir", str(tmp / "dist"), str(src))
+    wheel = next((tmp / "dist").glob("ikteach-*.whl"))
+    sdist = next((tmp / "dist").glob("ikteach-*.tar.gz"))
+    return wheel, sdist
+
+
+def _venv(tmp, python):
+    _uv("venv", "--quiet", "--python", str(python), str(tmp / "venv"))
+    return tmp / "venv" / "bin" / "python"
+
+
+def test_wheel_and_sdist_ship_the_module_and_package_data(dist):
+    wheel, sdist = dist
+    names = zipfile.ZipFile(wheel).namelist()
+    assert "ikteach/solve.py" in names and f"ikteach/{PROBE}" in names
+    assert not [n for n in names if "__pycache__" in n or n.startswith(("tests/", "notebooks/"))]
+    with tarfile.open(sdist) as tar:
+        members = tar.getnames()
+    assert any(m.endswith(f"ikteach/{PROBE}") for m in members)
+    metadata = zipfile.ZipFile(wheel).read(
+        next(n for n in names if n.endswith(".dist-info/METADATA"))).decode()
+    assert "Project-URL: Repository, https://github.com/" in metadata
+    requires = [line for line in metadata.splitlines() if line.startswith("Requires-Dist:")]
+    runtime = [r for r in requires if "extra ==" not in r]
+    assert {r.split()[1].split(">")[0].split("[")[0] for r in runtime} == {
+        "jax", "numpy", "matplotlib", "pyvista", "scikit-image", "ipywidgets"}
+
+
+def test_wheel_in_a_clean_venv_solves_plots_and_renders(dist, tmp_path):
+    wheel, _ = dist
+    python = _venv(tmp_path, sys.executable)
+    _uv("pip", "install", "--quiet", "--python", str(python), str(wheel),
+        "-c", str(ROOT / "binder" / "constraints.txt"))
+    work = tmp_path / "work"
+    work.mkdir()
+    (work / "smoke.py").write_text(SMOKE)
+    out = _run(python, "smoke.py", str(ROOT), "--scene", "--probe", PROBE, cwd=work).stdout
+    assert "solve: converged" in out and "plot: arm.png" in out
+    assert "scene: (" in out and "data: probe data file" in out
+    frozen = _uv("pip", "list", "--python", str(python)).stdout
+    for extra in ("jupyterlab", "nbclient", "pytest"):
+        assert f"\n{extra} " not in frozen, f"runtime install pulled {extra}"
+
+
+def _colab_python():
+    """A Python 3.12 like Colab's, if this machine has one (else the tests' own Python)."""
+    pyenv = Path(os.environ.get("PYENV_ROOT", Path.home() / ".pyenv")) / "versions"
+    candidates = sorted(str(p) for p in pyenv.glob(f"{COLAB_PYTHON}.*/bin/python"))
+    found = shutil.which(f"python{COLAB_PYTHON}")
+    if found and "shims" not in found:  # a pyenv shim refuses versions not selected
+        candidates.append(found)
+    return candidates[-1] if candidates else sys.executable
+
+
+def test_wheel_on_a_colab_like_kernel_keeps_colabs_versions(dist, tmp_path):
+    wheel, _ = dist
+    python = _venv(tmp_path, _colab_python())
+    _uv("pip", "install", "--quiet", "--python", str(python),
+        *[f"{name}=={version}" for name, version in COLAB.items()])
+    _uv("pip", "install", "--quiet", "--python", str(python), str(wheel))  # what Colab's cell does
+    listed = _uv("pip", "list", "--python", str(python)).stdout
+    for name, version in COLAB.items():
+        assert any(line.split()[:2] == [name, version] for line in listed.splitlines()), \
+            f"installing the wheel changed Colab's {name} {version}"
+    work = tmp_path / "work"
+    work.mkdir()
+    (work / "smoke.py").write_text(SMOKE)
+    out = _run(python, "smoke.py", str(ROOT), "--demo", cwd=work).stdout
+    assert "solve: converged" in out and "demo: 7.7.1" in out
