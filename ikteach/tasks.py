@@ -9,7 +9,6 @@ import dataclasses
 from .chain import Chain, reach
 from .jacobian import jacobian
 from .kinematics import fk
-from .planar import planar_fk, planar_jacobian
 from .tree import TreeTask
 
 
@@ -27,10 +26,10 @@ class PositionTask:
         return f"({arm.dim},)"
 
     def error(self, arm, target, theta):
-        return target - (planar_fk(arm, theta) if arm.dim == 2 else fk(arm, theta))
+        return target - fk(arm, theta)
 
     def jacobian(self, arm, theta):
-        return planar_jacobian(arm, theta) if arm.dim == 2 else jacobian(arm, theta)
+        return jacobian(arm, theta)
 
     def length_scale(self, arm):
         return float(reach(arm))
