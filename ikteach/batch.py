@@ -73,18 +73,18 @@ def _run_queue(method, task, arm, targets, thetas0, settings, max_iter, slots):
 
 def solve_batch(arm, targets, theta0, method="dls", tol=1e-3, max_iter=1000,
                 damping=DEFAULT_DAMPING, rcond=DEFAULT_RCOND, clamp=None, max_step=None,
-                stall_tol=None, gamma_max=GAMMA_MAX, weights=None):
+                stall_tol=None, gamma_max=GAMMA_MAX, weights=None, stop_rule="joint_steps"):
     """Solve for every row of targets (B, d); theta0 is one start (n,) or one per target (B, n).
 
     A spatial chain takes 4x4 pose targets too: targets (B, 4, 4), with weights as in ik.solve.
-    Same loop and stop rules as ik.solve (no trace is kept); method must be a name or a
+    Same loop, stop rules and stop_rule option as ik.solve (no trace is kept); method must be a name or a
     step function written with jax.numpy.
     """
     method = resolve_method(method)
     task, targets, theta0, settings, max_iter = check_problem(
         arm, targets, theta0, tol=tol, max_iter=max_iter, damping=damping, rcond=rcond,
         clamp=clamp, max_step=max_step, stall_tol=stall_tol, gamma_max=gamma_max, batch=True,
-        weights=weights)
+        weights=weights, stop_rule=stop_rule)
     if theta0.ndim == 1:
         theta0 = jnp.broadcast_to(theta0, (targets.shape[0], theta0.shape[0]))
     state = _run_queue(method, task, arm, targets, theta0, settings, max_iter,
