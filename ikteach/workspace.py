@@ -144,6 +144,8 @@ def plot_map(ax, image, grid, title, contours=(), radii=None, cmap="viridis", la
             if r > 0:
                 ax.plot(r * np.cos(t), r * np.sin(t), "k--", lw=0.8)
     ax.set_title(title)
+    ax.set_xlabel("target x")
+    ax.set_ylabel("target y")
     ax.set_aspect("equal")
     ax.grid(False)
     if label is not None:
