@@ -27,6 +27,8 @@ from .ccd import ccd_sweep, ccd_angle  # noqa: E402
 from .fabrik import fabrik_pass  # noqa: E402
 from .tree import Tree, tree, tree_fk, tree_frames, tree_jacobian, tree_jacobian_autodiff  # noqa: E402
 from .track import track, TrackResult  # noqa: E402
+from .jitter import jitter, jitter_per_step  # noqa: E402
+from . import stop_rules, settle  # noqa: E402
 from . import buss_trees  # noqa: E402
 from .pose import fk_pose, rotation_log, rotation_exp, pose_errors, make_pose, PoseTask  # noqa: E402
 from .robots import ur5, iiwa14  # noqa: E402
@@ -73,7 +75,7 @@ __all__ = [
     "StopSolve", "check",
     "sdls_step", "GAMMA_MAX", "ccd_sweep", "ccd_angle", "fabrik_pass",
     "Tree", "tree", "tree_fk", "tree_frames", "tree_jacobian", "tree_jacobian_autodiff",
-    "track", "TrackResult", "buss_trees", "tree_plot", "plot", "demo",
+    "track", "TrackResult", "jitter", "jitter_per_step", "stop_rules", "settle", "buss_trees", "tree_plot", "plot", "demo",
     "fk_pose", "rotation_log", "rotation_exp", "pose_errors", "make_pose", "PoseTask",
     "ur5", "iiwa14", "robots", "scene", "workspace", "live_map",
     "bvh", "skeleton", "clip_ik", "footplant", "look_at", "character_plot", "character_scene",

@@ -74,20 +74,21 @@ def _run_queue(method, task, arm, targets, thetas0, settings, max_iter, slots):
 
 def solve_batch(arm, targets, theta0, method="dls", tol=1e-3, max_iter=1000,
                 damping=DEFAULT_DAMPING, rcond=DEFAULT_RCOND, clamp=None, max_step=None,
-                stall_tol=None, gamma_max=GAMMA_MAX, weights=None, joint_limits=None,
-                limit_mode=None, levels=None, rest_pose=None, rest_gain=DEFAULT_REST_GAIN):
+                stall_tol=None, gamma_max=GAMMA_MAX, weights=None, stop_rule="joint_steps",
+                joint_limits=None, limit_mode=None, levels=None, rest_pose=None,
+                rest_gain=DEFAULT_REST_GAIN):
     """Solve for every row of targets (B, d); theta0 is one start (n,) or one per target (B, n).
 
     A spatial chain takes 4x4 pose targets too: targets (B, 4, 4), with weights as in ik.solve.
     Same loop and stop rules as ik.solve (no trace is kept); method must be a name or a
-    step function written with jax.numpy. joint_limits, limit_mode, levels, rest_pose and
-    rest_gain as in ik.solve.
+    step function written with jax.numpy. stop_rule, joint_limits, limit_mode, levels,
+    rest_pose and rest_gain as in ik.solve.
     """
     method = resolve_method(method)
     task, targets, theta0, settings, max_iter = check_problem(
         arm, targets, theta0, tol=tol, max_iter=max_iter, damping=damping, rcond=rcond,
         clamp=clamp, max_step=max_step, stall_tol=stall_tol, gamma_max=gamma_max, batch=True,
-        weights=weights)
+        weights=weights, stop_rule=stop_rule)
     method, settings, theta0 = with_extras(method, task, arm, targets, theta0, settings, levels,
                                            rest_pose, rest_gain, joint_limits, limit_mode, batch=True)
     if theta0.ndim == 1:

@@ -3,7 +3,9 @@
 Each iteration, at the current theta:
   1. e = target - F(theta); record theta and ||e|| in the trace;
   2. stop "converged" if ||e|| < tol (checked before any step is taken);
-  3. stop "stalled" if the last step had sum |delta_theta_i| < stall_tol (out of reach);
+  3. stop "stalled" if the last step was smaller than stall_tol (out of reach), or "slow" if
+     so but ||e|| still fell by a steady fraction (see stop_rules.py: the size is
+     sum |delta_theta_i| by default, ||J delta_theta|| with stop_rule="motion");
   4. stop "max_iter" after max_iter steps;
   5. otherwise delta_theta = cap(step(J, clamp(e))); a non-finite step stops "diverged"
      and keeps the last finite theta.
@@ -28,9 +30,10 @@ from .joint_limits import with_limits
 from .limits import cap_step, clamp_error
 from .pinv import DEFAULT_RCOND, pinv_step
 from .tasks import task_for
+from . import stop_rules
 
-STATUSES = ("running", "converged", "stalled", "max_iter", "diverged")
-RUNNING, CONVERGED, STALLED, MAX_ITER, DIVERGED = range(5)
+STATUSES = ("running", "converged", "stalled", "max_iter", "diverged", "slow")  # append only
+RUNNING, CONVERGED, STALLED, MAX_ITER, DIVERGED, SLOW = range(6)
 
 DEFAULT_DAMPING = 0.5
 STALL_FRACTION = 1e-5  # default stall_tol = STALL_FRACTION * total link length
@@ -61,6 +64,7 @@ class Settings(NamedTuple):
     upper: object = np.inf
     rest_pose: object = 0.0  # the rest-pose level of a prioritised solve (ikteach/levels.py)
     rest_gain: float = 0.0
+    stop_rule: int = 0  # index into stop_rules.STOP_RULES
 
 
 def _jt(J, e, s):
@@ -141,6 +145,8 @@ def advance(method, task, arm, target, settings, max_iter, state):
         [~jnp.isfinite(err), err < settings.tol,
          (state.i > 0) & (state.last_step < settings.stall_tol), state.i >= max_iter],
         [DIVERGED, CONVERGED, STALLED, MAX_ITER], RUNNING)
+    status = jnp.where((status == STALLED) & stop_rules.still_progressing(state.error, err),
+                       SLOW, status)
     delta = jnp.asarray(method.delta(task, arm, target, state.theta, e, settings))
     if delta.shape != state.theta.shape:
         raise ValueError(f"method: the step function returned shape {delta.shape}, "
@@ -155,7 +161,8 @@ def advance(method, task, arm, target, settings, max_iter, state):
     trace_theta = state.trace_theta
     if trace_theta.size:
         trace_theta = jnp.where(take, trace_theta.at[i].set(new_theta), trace_theta)
-    return State(i, theta, err, jnp.where(take, jnp.sum(jnp.abs(delta)), state.last_step),
+    size = stop_rules.step_size(settings.stop_rule, lambda: task.jacobian(arm, state.theta), delta)
+    return State(i, theta, err, jnp.where(take, size, state.last_step),
                  status, trace_theta, trace_error)
 
 
@@ -249,7 +256,7 @@ def with_extras(method, task, arm, target, theta0, settings, levels, rest_pose, 
 
 def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, max_step,
                   stall_tol, gamma_max=GAMMA_MAX, batch=False,
-                  weights=None):
+                  weights=None, stop_rule=stop_rules.DEFAULT_STOP_RULE):
     """Validate everything solve/solve_batch take.
 
     Returns (task, target, theta0, settings, max_iter). With batch=True, target holds
@@ -281,14 +288,15 @@ def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, 
         max_step=np.inf if max_step is None else as_number(max_step, "max_step", minimum=0, strict=True),
         stall_tol=as_number(stall_tol, "stall_tol", minimum=0),
         gamma_max=as_number(gamma_max, "gamma_max", minimum=0, strict=True),
+        stop_rule=stop_rules.rule_index(stop_rule),
     )
     return task, jnp.asarray(target), jnp.asarray(theta0), settings, max_iter
 
 
 def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DEFAULT_DAMPING,
           rcond=DEFAULT_RCOND, clamp=None, max_step=None, stall_tol=None, gamma_max=GAMMA_MAX,
-          weights=None, joint_limits=None, limit_mode=None, levels=None, rest_pose=None,
-          rest_gain=DEFAULT_REST_GAIN):
+          weights=None, stop_rule=stop_rules.DEFAULT_STOP_RULE, joint_limits=None,
+          limit_mode=None, levels=None, rest_pose=None, rest_gain=DEFAULT_REST_GAIN):
     """Solve F(theta) = target from theta0 by repeated steps of `method`.
 
     method    "jt", "pinv", "dls", "sdls", "ccd", "fabrik", or a function step(J, e) -> delta_theta
@@ -298,8 +306,11 @@ def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DE
     damping   lambda of DLS.   rcond: the pseudoinverse's relative cut-off.
     clamp     Buss's D_max: |e| is clamped to at most D_max before each step.
     max_step  cap on any joint's change per step, in radians.
-    stall_tol stop "stalled" when sum |delta_theta_i| < stall_tol
+    stall_tol stop "stalled" (or "slow": still converging) when the last step's size < stall_tol
               (default STALL_FRACTION * total link length; 0 turns it off).
+    stop_rule the step's size: "joint_steps" (the report's sum |delta_theta_i|, radians: the
+              default, depends on the unit of length) or "motion" (||J delta_theta||, the
+              end effector's motion: scale-free, recommended). See ikteach/stop_rules.py.
     gamma_max SDLS's largest joint turn per step (default pi/4).
     weights   for a 4x4 pose target: (position_weight, orientation_weight), default (1, 1).
     joint_limits  (lower, upper): per-joint arrays (or numbers), +-inf for no limit; every
@@ -316,7 +327,7 @@ def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DE
     task, target, theta0, settings, max_iter = check_problem(
         arm, target, theta0, tol=tol, max_iter=max_iter, damping=damping, rcond=rcond,
         clamp=clamp, max_step=max_step, stall_tol=stall_tol, gamma_max=gamma_max,
-        weights=weights)
+        weights=weights, stop_rule=stop_rule)
     method, settings, theta0 = with_extras(method, task, arm, target, theta0, settings, levels,
                                            rest_pose, rest_gain, joint_limits, limit_mode)
     args = (method, task, arm, target, theta0, settings, max_iter, True)

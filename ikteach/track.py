@@ -12,6 +12,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ._validate import as_array, as_number
+from .jitter import jitter
 from .limits import cap_step
 from .pinv import DEFAULT_RCOND
 from .sdls import GAMMA_MAX
@@ -32,10 +33,8 @@ class TrackResult:
 
     @property
     def jitter(self):
-        """Mean over steps of sum_j |delta_theta_j(t) - delta_theta_j(t-1)|: how much the
-        joint velocities change from one step to the next (0 for smooth motion)."""
-        step = np.diff(self.theta, axis=0)
-        return float(np.mean(np.abs(np.diff(step, axis=0)).sum(axis=1)))
+        """ik.jitter of the joint path: the mean of sum_j |theta_j(t+1) - 2 theta_j(t) + theta_j(t-1)|."""
+        return jitter(self.theta)
 
 
 def clamp_blocks(e, block, d_max):

@@ -13,11 +13,12 @@ from .batch import solve_batch
 from .jacobian import jacobian
 from ._validate import as_array
 from .kinematics import end_path  # noqa: F401  (ws.end_path, used by the notebook)
+from .jitter import jitter_per_step
 from .solve import status_counts
 from .track import track as follow
 
 STATUS_COLORS = {"converged": "#55a868", "stalled": "#dd8452", "max_iter": "#c44e52",
-                 "diverged": "#222222"}
+                 "diverged": "#222222", "slow": "#8172b3"}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -143,6 +144,8 @@ def plot_map(ax, image, grid, title, contours=(), radii=None, cmap="viridis", la
             if r > 0:
                 ax.plot(r * np.cos(t), r * np.sin(t), "k--", lw=0.8)
     ax.set_title(title)
+    ax.set_xlabel("target x")
+    ax.set_ylabel("target y")
     ax.set_aspect("equal")
     ax.grid(False)
     if label is not None:
@@ -200,13 +203,12 @@ class Tracking:
 
     @property
     def jitter(self):
-        """|theta[k+1] - 2 theta[k] + theta[k-1]|: the joints' second difference per frame."""
-        return np.linalg.norm(np.diff(self.theta, n=2, axis=0), axis=1)
+        """ik.jitter_per_step: sum_i |theta_i[k+1] - 2 theta_i[k] + theta_i[k-1]| per frame."""
+        return jitter_per_step(self.theta)
 
     def summary(self):
         return {"mean error": float(self.error.mean()), "max error": float(self.error.max()),
-                "rms jitter": float(np.sqrt(np.mean(self.jitter**2))),
-                "max jitter": float(self.jitter.max())}
+                "mean jitter": float(self.jitter.mean()), "max jitter": float(self.jitter.max())}
 
 
 def track(arm, path, theta0, method="dls", damping=0.5, rcond=1e-6, clamp=None, max_step=None):

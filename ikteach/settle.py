@@ -1,0 +1,52 @@
+"""Does DLS settle on an out-of-reach target? The stretched pose as a fixed point.
+
+Out of reach, d beyond the reach of a planar chain, DLS's fixed point is the arm stretched
+toward the target: there every column of J is tangential, e = d r (r the radial unit vector)
+is orthogonal to J's range, so J^T e = 0 and the step is 0. Near it, for a small joint
+deviation delta, the DLS step is linear in delta:
+
+    delta <- M delta,   M = (J^T J + lambda^2 I)^-1 (lambda^2 I - d A),
+
+where A_ij = sum of the lengths of links k >= max(i, j) (-A is the Hessian of the tip's
+distance from the base at the stretched pose). DLS settles (the step shrinks, the stall rule
+fires: "stalled") when the spectral radius of M is below 1; otherwise it swings around the
+stretched pose until max_iter. A larger lambda settles; a larger d needs a larger lambda.
+Buss's clamp limits the error the step sees to D_max, so d is replaced by min(d, D_max).
+"""
+import numpy as np
+
+from .chain import Chain
+
+
+def _lengths(arm):
+    if not isinstance(arm, Chain) or arm.dim != 2:
+        raise ValueError("arm: expected a planar chain from ik.planar_chain")
+    return np.linalg.norm(np.asarray(arm.offsets), axis=1)
+
+
+def stretched_matrices(arm):
+    """(J^T J, A) at the stretched pose, in the frame of the stretch direction."""
+    tail = np.cumsum(_lengths(arm)[::-1])[::-1]  # tail[i] = sum of the lengths of links k >= i
+    n = len(tail)
+    A = tail[np.maximum.outer(np.arange(n), np.arange(n))]
+    return np.outer(tail, tail), A
+
+
+def settle_factor(arm, distance, damping, clamp=None):
+    """Spectral radius of M: below 1, DLS settles stretched; above 1, it does not."""
+    d = distance if clamp is None else min(distance, clamp)
+    JtJ, A = stretched_matrices(arm)
+    eye = np.eye(len(A))
+    M = np.linalg.solve(JtJ + damping**2 * eye, damping**2 * eye - d * A)
+    return float(np.abs(np.linalg.eigvals(M)).max())
+
+
+def smallest_settling_damping(arm, distance, clamp=None):
+    """The lambda above which DLS settles at this distance beyond the reach (bisection)."""
+    lo, hi = 0.0, 1.0
+    while settle_factor(arm, distance, hi, clamp) >= 1:
+        hi *= 2
+    for _ in range(60):
+        mid = (lo + hi) / 2
+        lo, hi = (lo, mid) if settle_factor(arm, distance, mid, clamp) < 1 else (mid, hi)
+    return hi
