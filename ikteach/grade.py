@@ -31,7 +31,7 @@ from pathlib import Path
 
 NOTEBOOK_TIMEOUT = 120.0  # seconds for all of a student's cells
 GRADE_TIMEOUT = 180.0     # seconds for the grader's own cell
-EXERCISE_NUMBERS = range(1, 7)
+EXERCISE_NUMBERS = range(1, 8)
 POINTS = 10
 
 _GRADE_CELL = """\
