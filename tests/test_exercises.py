@@ -14,7 +14,7 @@ TEMPLATES = sorted((ROOT / "notebooks" / "exercises").glob("*.ipynb"))
 
 
 def test_one_template_per_solution():
-    assert len(SOLUTIONS) == 6
+    assert len(SOLUTIONS) == 7
     assert [p.name for p in TEMPLATES] == [p.name for p in SOLUTIONS]
 
 

@@ -44,7 +44,7 @@ def graded(tmp_path_factory):
 
 
 def scores(row):
-    return [float(row[f"ex{n}"]) for n in range(1, 7)], float(row["total"])
+    return [float(row[f"ex{n}"]) for n in range(1, 8)], float(row["total"])
 
 
 def test_one_row_and_one_feedback_file_per_student(graded):
@@ -55,8 +55,8 @@ def test_one_row_and_one_feedback_file_per_student(graded):
 
 def test_solutions_get_full_marks(graded):
     rows, feedback, *_ = graded
-    assert scores(rows["solutions"]) == ([10.0] * 6, 60.0)
-    assert feedback["solutions"].count("passed, 10/10") == 6
+    assert scores(rows["solutions"]) == ([10.0] * 7, 70.0)
+    assert feedback["solutions"].count("passed, 10/10") == 7
     # exercise 6's written answer is copied for the instructor, not marked
     assert "your written answer (not marked by the checker" in feedback["solutions"]
     assert "| Stretched towards a target it cannot reach" in feedback["solutions"]
@@ -64,8 +64,8 @@ def test_solutions_get_full_marks(graded):
 
 def test_untouched_templates_get_zero(graded):
     rows, feedback, *_ = graded
-    assert scores(rows["untouched"]) == ([0.0] * 6, 0.0)
-    assert feedback["untouched"].count("not yet implemented") == 6
+    assert scores(rows["untouched"]) == ([0.0] * 7, 0.0)
+    assert feedback["untouched"].count("not yet implemented") == 7
     assert "your written answer" not in feedback["untouched"]  # the placeholder is skipped
 
 

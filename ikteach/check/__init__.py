@@ -31,10 +31,13 @@ from .ex04_dls_step import check as dls_step, verdict as dls_step_verdict
 from .ex05_stop_rule import check as stop_rule, verdict as stop_rule_verdict
 from .ex06_singularity_study import check as singularity_study
 from .ex06_singularity_study import verdict as singularity_study_verdict
+from .ex07_priority_step import check as priority_step
+from .ex07_priority_step import verdict as priority_step_verdict
 from .registry import EXERCISES, grade
 from .verdicts import POINTS, Verdict
 
 __all__ = ["jacobian", "jt_step", "pinv_step", "dls_step", "stop_rule", "singularity_study",
+           "priority_step", "priority_step_verdict",
            "jacobian_verdict", "jt_step_verdict", "pinv_step_verdict", "dls_step_verdict",
            "stop_rule_verdict", "singularity_study_verdict", "grade", "EXERCISES", "POINTS",
            "Verdict", "registry", "verdicts"]

@@ -1,10 +1,10 @@
 """The exercise list: number -> its check module, and grade(number, namespace) for the grader."""
 from . import (ex01_jacobian, ex02_jt_step, ex03_pinv_step, ex04_dls_step, ex05_stop_rule,
-               ex06_singularity_study)
+               ex06_singularity_study, ex07_priority_step)
 from .verdicts import POINTS, _evaluate, _Part
 
 MODULES = (ex01_jacobian, ex02_jt_step, ex03_pinv_step, ex04_dls_step, ex05_stop_rule,
-           ex06_singularity_study)
+           ex06_singularity_study, ex07_priority_step)
 EXERCISES = {module.NUMBER: module for module in MODULES}
 
 
