@@ -110,4 +110,4 @@ def test_not_implemented_and_not_a_function():
 def test_registered_for_the_grader():
     namespace = {"priority_step": correct}
     assert ik.check.grade(7, namespace).score == 10
-    assert ik.check.EXERCISES[7][1] == ("priority_step",)
+    assert ik.check.EXERCISES[7].FUNCTIONS == ("priority_step",)
