@@ -3,7 +3,7 @@ with ik.solve_batch and redraw the map (iterations, final error or status) as a 
 
     live = ik.live_map.LiveMap()      # widgets; live.widget to display in a notebook
     live.update(damping=0.2)          # what a control change does; returns the SweepMap
-    live.png                          # the current picture (a static still for static viewers)
+    live.png, live.still()            # the current picture; as HTML with alt text (static viewers)
 
 The batch is compiled once per method; a new lambda is a traced number, so a change costs
 one solve_batch over the grid and one small PNG render.
@@ -64,10 +64,12 @@ class LiveMap:
         self.widget = w.VBox([w.HBox([self.damping, self.method, self.quantity]), self.text,
                               self.image])
         self._fig = Figure(figsize=(4.2, 4.2), dpi=80)
-        self._ax = self._fig.add_axes((0.1, 0.08, 0.86, 0.84))
+        self._ax = self._fig.add_axes((0.13, 0.1, 0.83, 0.79))
         self._im = self._ax.imshow(np.zeros(self.grid.shape), origin="lower",
                                    extent=self.grid.extent, interpolation="nearest")
         self._ax.set_aspect("equal")
+        self._ax.set_xlabel("target x", fontsize=8)
+        self._ax.set_ylabel("target y", fontsize=8)
         self._ax.grid(False)
         self._title = self._ax.set_title("", fontsize=8)
         self._holding = False
@@ -111,3 +113,11 @@ class LiveMap:
         buf = io.BytesIO()
         self._fig.savefig(buf, format="png")
         return buf.getvalue()
+
+    def still(self):
+        """The current map as static HTML (an <img> with alt text), for viewers without a kernel."""
+        from IPython.display import HTML
+
+        from .alt_text import figure_alt, img_html
+
+        return HTML(img_html(self.png, f"Workspace map, {self.summary}. {figure_alt(self._fig)}"))

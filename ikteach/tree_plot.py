@@ -27,15 +27,21 @@ def draw_tree(ax, arm, theta, targets=None, plane=(0, 1), color="C0"):
     return lines, joints, effs, tgt
 
 
-def animate_tree(arm, thetas, targets, plane=(0, 1), limits=((-2.5, 4.0), (-1.0, 2.5)), interval=50):
-    """A FuncAnimation of the tree following its targets (one frame per row of thetas)."""
+def animate_tree(arm, thetas, targets, plane=(0, 1), limits=((-2.5, 4.0), (-1.0, 2.5)), interval=50,
+                 times=None, title="tree"):
+    """A FuncAnimation of the tree following its targets (one frame per row of thetas), titled
+    with the time of each frame (`times`, s) when given; show it with ik.plot.show (still frame)."""
     import matplotlib.pyplot as plt
-    from matplotlib.animation import FuncAnimation
+
+    from .plot import _animation
 
     fig, ax = plt.subplots(figsize=(5.5, 3.4))
     ax.set_xlim(*limits[0])
     ax.set_ylim(*limits[1])
     lines, joints, effs, tgt = draw_tree(ax, arm, thetas[0], targets[0], plane)
+    effs.set_label("end effectors")
+    tgt.set_label("targets")
+    ax.legend(loc="upper right", fontsize=8)
     i, j = plane
 
     def frame(k):
@@ -45,8 +51,8 @@ def animate_tree(arm, thetas, targets, plane=(0, 1), limits=((-2.5, 4.0), (-1.0,
         joints.set_data(p[:, i], p[:, j])
         effs.set_data(x[:, i], x[:, j])
         tgt.set_data(targets[k][:, i], targets[k][:, j])
+        when = f"t = {times[k]:5.2f} s" if times is not None else f"frame {k}"
+        ax.set_title(f"{title}: {when}", fontsize=9)
         return (*lines, joints, effs, tgt)
 
-    anim = FuncAnimation(fig, frame, frames=len(thetas), interval=interval, blit=True)
-    plt.close(fig)
-    return anim
+    return _animation(fig, frame, np.arange(len(thetas)), interval=interval)

@@ -162,8 +162,11 @@ def _images(nb):
                 alt = output.get("metadata", {}).get("image/png", {}).get("alt")
                 yield i, png, alt
             html = "".join(data.get("text/html", []))
-            for m in re.finditer(r'<img (?:alt="([^"]*)" )?src="data:image/png;base64,([^"]+)"', html):
-                yield i, base64.b64decode(m.group(2)), m.group(1)
+            for tag in re.findall(r"<img\b[^>]*>", html):
+                src = re.search(r'src="data:image/png;base64,([^"]+)"', tag)
+                alt = re.search(r'alt="([^"]*)"', tag)
+                if src:
+                    yield i, base64.b64decode(src.group(1)), alt and alt.group(1)
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.relative_to(ROOT).as_posix())
