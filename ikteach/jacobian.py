@@ -9,9 +9,9 @@ from .kinematics import fk, joint_frames
 
 @partial(jax.jit, static_argnames="full")
 def jacobian(arm, theta, full=False):
-    """Geometric Jacobian: column i is w_i x (p_e - p_i).
+    """Geometric Jacobian: column i is z_i x (p_e - p_i), z_i joint i's unit axis.
 
-    Shape (d, n). With full=True the angular rows w_i are appended:
+    Shape (d, n). With full=True the angular rows z_i are appended:
     (6, n) for a spatial chain, (3, n) for a planar arm (x, y and the angle about z).
     """
     positions, axes, _ = joint_frames(arm, theta)

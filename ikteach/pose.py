@@ -3,12 +3,12 @@
 A pose is a 4x4 homogeneous transform T = [[R, p], [0, 1]]. The pose error stacks the
 position error and the orientation error as an axis-angle vector:
 
-    e = [ w_p (p_t - p(theta)) ;  w_o log(R_t R(theta)^T) ]          (6,)
+    e = [ beta_p (p_t - p(theta)) ;  beta_o log(R_t R(theta)^T) ]          (6,)
 
 log(R_t R^T) is the rotation vector omega with R_t = exp([omega]x) R: the small rotation
 that takes the current hand to the target, in world coordinates. Its derivative at
-omega = 0 is the angular part of the geometric Jacobian (rows w_i), so the 6 x n
-Jacobian [w_i x (p_e - p_i); w_i] (ik.jacobian(arm, theta, full=True)) drives it.
+omega = 0 is the angular part of the geometric Jacobian (rows z_i, the joint axes), so the 6 x n
+Jacobian [z_i x (p_e - p_i); z_i] (ik.jacobian(arm, theta, full=True)) drives it.
 """
 import dataclasses
 
@@ -98,8 +98,8 @@ def orientation_error(R_target, R):
 class PoseTask:
     """Reach a 4x4 pose with a spatial chain.
 
-    e = [w_p (p_t - p); w_o log(R_t R^T)],  J = diag(w_p I, w_o I) [w_i x (p_e - p_i); w_i].
-    The weights are fixed per task (ik.solve(..., weights=(w_p, w_o)) makes a new one).
+    e = [beta_p (p_t - p); beta_o log(R_t R^T)],  J = diag(beta_p I, beta_o I) [z_i x (p_e - p_i); z_i].
+    The weights are fixed per task (ik.solve(..., weights=(beta_p, beta_o)) makes a new one).
     """
     position_weight: float = 1.0
     orientation_weight: float = 1.0
@@ -127,7 +127,7 @@ class PoseTask:
         return float(reach(arm))
 
     def weighted(self, weights):
-        """The same task with weights (w_p, w_o) on the position and orientation errors."""
+        """The same task with weights (beta_p, beta_o) on the position and orientation errors."""
         try:
             w_p, w_o = weights
         except (TypeError, ValueError):

@@ -44,15 +44,15 @@ def _diagnose_jacobian(got, want, case):
         return f"your Jacobian contains NaN or inf.{_mismatch(got, want, case, 'J')}"
     if _close(got, -want):
         return ("wrong sign: your Jacobian is -1 x the expected one. Column i is "
-                "w_i x (p_e - p_i) = z x (p_e - p_i) = (-(y_e - y_i), x_e - x_i)."
+                "z_i x (p_e - p_i) = z x (p_e - p_i) = (-(y_e - y_i), x_e - x_i)."
                 + _mismatch(got, want, case, "J"))
     if _close(got, want[:, ::-1]):
-        return ("the columns are in reverse order: column i belongs to joint i (joint 0 "
-                "at the base)." + _mismatch(got, want, case, "J"))
+        return ("the columns are in reverse order: column i belongs to joint i (J[:, 0] is "
+                "joint 1, at the base)." + _mismatch(got, want, case, "J"))
     if _close(got, want[::-1]):
         return "rows swapped: row 0 is dx, row 1 is dy." + _mismatch(got, want, case, "J")
     return ("wrong values: column i should be z x (p_e - p_i), p_i the position of joint i "
-            "(p_0 = the base), p_e the end effector." + _mismatch(got, want, case, "J"))
+            "(p_1 = the base = row 0 of ik.joint_positions), p_e the end effector." + _mismatch(got, want, case, "J"))
 
 
 def _columns_up_to_sign(got, want):
