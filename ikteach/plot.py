@@ -22,7 +22,7 @@ import jax.numpy as jnp
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.animation import FuncAnimation
-from matplotlib.ticker import FuncFormatter, NullFormatter
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from .chain import reach
 from .jacobian import jacobian
@@ -53,6 +53,20 @@ def arm_axes(ax, arm, margin=1.25, targets=()):
         lo, hi = np.minimum(lo, t - 0.2 * r / margin), np.maximum(hi, t + 0.2 * r / margin)
     ax.set_xlim(lo[0], hi[0])
     ax.set_ylim(lo[1], hi[1])
+    ax.set_aspect("equal")
+    return ax
+
+
+def motion_axes(ax, arm, thetas, targets=(), pad=0.12):
+    """Equal aspect, limits zoomed to the motion: every joint of the arm at each of `thetas`
+    and the targets, with `pad` x the larger side around them (at least 10 % of the reach)."""
+    points = [_xy(arm, t) for t in thetas] + [np.asarray(t, dtype=float)[None, :2] for t in targets]
+    points = np.concatenate(points)
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    half = max(float(np.max(hi - lo)) / 2 * (1 + 2 * pad), 0.1 * float(reach(arm)))
+    mid = (lo + hi) / 2
+    ax.set_xlim(mid[0] - half, mid[0] + half)
+    ax.set_ylim(mid[1] - half, mid[1] + half)
     ax.set_aspect("equal")
     return ax
 
@@ -148,11 +162,19 @@ def plot_errors(ax, results, tol=None):
     return lines
 
 
+def _tick_text(y, _pos=None):
+    """0.5, 2, 1e-3: plain tick labels (mathtext is slow to redraw per frame)."""
+    return f"{y:g}" if 1e-2 <= y < 1e4 else f"{y:.0e}".replace("e-0", "e-").replace("e+0", "e")
+
+
 def _error_axis(ax):
-    """Label an error axis; plain '1e-3' tick labels (mathtext is slow to redraw per frame)."""
+    """Label a log error axis with enough ticks: 1-2-5 per decade when it spans few decades."""
     ax.set_xlabel("iteration")
     ax.set_ylabel("|e|")
-    ax.yaxis.set_major_formatter(FuncFormatter(lambda y, _: f"{y:.0e}".replace("e-0", "e-")))
+    lo, hi = ax.get_ylim()
+    few = np.log10(hi / lo) < 3 if lo > 0 else False
+    ax.yaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0) if few else (1.0,)))
+    ax.yaxis.set_major_formatter(FuncFormatter(_tick_text))
     ax.yaxis.set_minor_formatter(NullFormatter())
 
 
@@ -191,13 +213,14 @@ def animate_solve(arm, result, target, max_frames=MAX_FRAMES, title=None, spacin
     """
     ks = frame_iterations(result.iterations, max_frames, spacing)
     fig, (ax, ax_err) = plt.subplots(1, 2, figsize=figsize, gridspec_kw={"width_ratios": [1, 1.2]})
-    arm_axes(ax, arm, targets=[target])
-    draw_reach(ax, arm)
-    draw_arm(ax, arm, result.trace.theta[0], color="0.7", lw=2, joints=False)
+    motion_axes(ax, arm, result.trace.theta[ks], targets=[target])
+    draw_reach(ax, arm, label="reach")
+    draw_arm(ax, arm, result.trace.theta[0], color="0.7", lw=2, joints=False, label="start pose")
     draw_target(ax, target)
     path = end_path(arm, result.trace.theta)
-    (trail,) = ax.plot([], [], ".-", color="C1", lw=1, ms=3)
-    arm_artists = draw_arm(ax, arm, result.trace.theta[0])
+    (trail,) = ax.plot([], [], ".-", color="C1", lw=1, ms=3, label="end-effector path")
+    arm_artists = draw_arm(ax, arm, result.trace.theta[0], label="arm")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3, fontsize=7, frameon=False)
     heading = ax.set_title(title or "", fontsize=9)
     err = np.maximum(result.trace.error, 1e-16)
     ax_err.semilogy(np.arange(err.size), err, "-", color="0.75")
@@ -231,14 +254,16 @@ def animate_race(arm, results, target, max_frames=MAX_FRAMES, spacing="log", fig
     longest = max(r.iterations for r in results.values())
     ks = frame_iterations(longest, max_frames, spacing)
     n = len(names)
-    figsize = figsize or (2.4 * n + 3.0, 2.7)
-    fig, axes = plt.subplots(1, n + 1, figsize=figsize,
-                             gridspec_kw={"width_ratios": [1] * n + [1.3]})
-    ax_err = axes[-1]
+    figsize = figsize or (max(7.5, 2.5 * n), 5.4)
+    fig = plt.figure(figsize=figsize)
+    grid = fig.add_gridspec(2, n, height_ratios=[1.1, 1])
+    axes = [fig.add_subplot(grid[0, k]) for k in range(n)]
+    ax_err = fig.add_subplot(grid[1, :])
     artists, trails, headings, paths, dots = [], [], [], [], []
     for k, (name, ax) in enumerate(zip(names, axes)):
         res, c = results[name], color_for(name, k)
-        arm_axes(ax, arm, targets=[target])
+        shown = np.minimum(ks, res.iterations)
+        motion_axes(ax, arm, res.trace.theta[shown], targets=[target])
         draw_reach(ax, arm)
         draw_target(ax, target, label=None)
         paths.append(end_path(arm, res.trace.theta))
@@ -256,7 +281,7 @@ def animate_race(arm, results, target, max_frames=MAX_FRAMES, spacing="log", fig
         ax_err.set_xscale("symlog", linthresh=10)
         ax_err.xaxis.set_major_formatter(FuncFormatter(lambda x, _: f"{x:.0f}"))
     ax_err.set_xlim(0, longest * 1.05 + 0.5)
-    ax_err.legend(loc="upper right", fontsize=7)
+    ax_err.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
 
     def frame(j):
         k = ks[j]

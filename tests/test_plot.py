@@ -88,3 +88,26 @@ def test_plot_errors_draws_one_curve_per_result():
     for line, res in zip(lines, results.values()):
         np.testing.assert_allclose(line.get_ydata(), res.trace.error)
     plt.close(fig)
+
+
+def test_motion_axes_zoom_to_every_joint_and_the_target():
+    fig, ax = plt.subplots()
+    thetas = [START, np.array([0.5, 0.4, 0.2])]
+    target = [2.5, 0.5]
+    plot.motion_axes(ax, ARM, thetas, targets=[target])
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    points = np.concatenate([np.asarray(ik.joint_positions(ARM, t))[:, :2] for t in thetas] + [[target]])
+    assert np.all((points[:, 0] > x0) & (points[:, 0] < x1) & (points[:, 1] > y0) & (points[:, 1] < y1))
+    assert x1 - x0 < 2 * float(ik.reach(ARM))  # tighter than the whole reach
+    plt.close(fig)
+
+
+@pytest.mark.parametrize("low, labels_at_least", [(0.3, 2), (1e-8, 4)])
+def test_error_axis_has_enough_tick_labels(low, labels_at_least):
+    fig, ax = plt.subplots()
+    plot.plot_errors(ax, {"dls": np.geomspace(1.0, low, 20)})
+    fig.canvas.draw()
+    lo, hi = ax.get_ylim()
+    labels = [t.get_text() for t in ax.get_yticklabels() if lo <= t.get_position()[1] <= hi]
+    assert len([t for t in labels if t]) >= labels_at_least, labels
+    plt.close(fig)

@@ -1,5 +1,7 @@
 """pyvista scenes: off-screen rendering, image regression against a committed reference."""
+import base64
 import importlib.util
+import io
 
 import numpy as np
 import pytest
@@ -60,6 +62,14 @@ def test_solve_gif_writes_frames(tmp_path):
     with Image.open(path) as gif:
         assert gif.n_frames == min(5, len(res.trace.theta))
         assert gif.size == (320, 240)
+    view = scene.show_gif(path, "a UR5 reaching")
+    data, meta = view._repr_mimebundle_()
+    assert data["text/html"].startswith('<img alt="a UR5 reaching" src="data:image/gif;base64,')
+    png = base64.b64decode(data["image/png"])
+    assert png.startswith(b"\x89PNG") and "a UR5 reaching" in meta["image/png"]["alt"]
+    with Image.open(io.BytesIO(png)) as still, Image.open(path) as gif:
+        gif.seek(gif.n_frames - 1)
+        assert np.array_equal(np.asarray(still.convert("RGB")), np.asarray(gif.convert("RGB")))
 
 
 @pytest.fixture
