@@ -51,13 +51,14 @@ def test_bubblewrap_hides_blocks_writes_and_network_or_the_report_says_not(sandb
     enforced, not_enforced = box.report()
     outside = tmp_path / "escaped.txt"  # under /tmp: bubblewrap gives the run a private /tmp
     repo = Path(__file__).resolve().parents[1] / "ESCAPED-sandbox-test.txt"  # read-only there
+    home = Path.home() / "ESCAPED-sandbox-test.txt"  # on the read-only root wherever the repo is
     server = socket.socket()
     server.bind(("127.0.0.1", 0))
     server.listen()
     port = server.getsockname()[1]
     code, out = run_in(box, tmp_path, f"""
         import os, socket
-        for path in [{str(outside)!r}, {str(repo)!r}]:
+        for path in [{str(outside)!r}, {str(repo)!r}, {str(home)!r}]:
             try:
                 open(path, "w").write("x"); print("wrote")
             except OSError as exc:
@@ -72,10 +73,11 @@ def test_bubblewrap_hides_blocks_writes_and_network_or_the_report_says_not(sandb
     if box.bwrap:
         assert "no write" in out and "no network" in out, out
         assert "secret files: None" in out or "secret files: []" in out, out
-        assert not outside.exists() and not repo.exists()
+        assert not outside.exists() and not repo.exists() and not home.exists()  # nothing escaped
         assert any("no network" in line for line in enforced)
     else:
         repo.unlink(missing_ok=True)
+        home.unlink(missing_ok=True)
         assert any(line.startswith("network") for line in not_enforced)
         assert any("writes outside the working folder" in line for line in not_enforced)
 
@@ -120,3 +122,22 @@ def test_extraction_keeps_definitions_and_drops_the_rest():
     assert extract.code_cells(book) == [(2, "a = 1\nb = 2\n")]
     with pytest.raises(SyntaxError):
         extract.kept_statements("def (:")
+
+
+def test_a_python_under_tmp_is_bound_back_read_only(tmp_path):
+    # bubblewrap gives the run a private /tmp: a checkout or venv there must be bound back
+    box = Sandbox([tmp_path / "class"], bwrap="/usr/bin/bwrap")
+    try:
+        box.bwrap = "/usr/bin/bwrap"  # the command line only; nothing is run
+        box.needed = [Path("/tmp/course/.venv"), Path("/tmp/course/ikteach"), Path("/usr")]
+        box.hidden = [Path("/tmp/course/.venv/secret"), Path("/tmp/other"), Path("/srv/solutions")]
+        cmd = box.command(["python", "-c", "1"], tmp_path, None)
+        binds = [cmd[i + 1] for i, a in enumerate(cmd) if a == "--ro-bind"]
+        tmpfs = [cmd[i + 1] for i, a in enumerate(cmd) if a == "--tmpfs"]
+        assert "/tmp/course/.venv" in binds and "/tmp/course/ikteach" in binds
+        assert "/usr" not in binds[1:]  # outside /tmp: already there via the read-only root
+        assert "/tmp/course/.venv/secret" in tmpfs and "/srv/solutions" in tmpfs
+        assert "/tmp/other" not in tmpfs  # gone with the private /tmp anyway
+        assert cmd.index("/tmp/course/.venv") < cmd.index("/tmp/course/.venv/secret")  # bind, then hide
+    finally:
+        box.close()

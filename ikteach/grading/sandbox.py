@@ -59,7 +59,9 @@ class Sandbox:
         self.limits = limits
         self.work_root = Path(tempfile.mkdtemp(prefix="ikteach-grade-")).resolve()
         needed = [Path(__file__).resolve().parents[1], Path(sys.prefix).resolve(),
+                  Path(sys.base_prefix).resolve(),
                   Path(sys.executable).resolve()]  # ikteach and the Python it runs on
+        self.needed = needed
         wanted = [Path(p).resolve() for p in hidden if p and Path(p).exists()]
         self.hidden = [p for p in wanted if not any(p == n or p in n.parents for n in needed)]
         self.unhidden = [p for p in wanted if p not in self.hidden]
@@ -128,8 +130,13 @@ class Sandbox:
             return launch + list(argv)
         wrap = [self.bwrap, "--ro-bind", "/", "/", "--dev", "/dev", "--proc", "/proc",
                 "--tmpfs", "/tmp", "--tmpfs", "/dev/shm"]
-        for path in self.hidden:
-            if not Path("/tmp") in path.parents:
+        tmp = Path("/tmp")
+        kept = [p for p in self.needed if tmp in p.parents]  # a checkout or venv under /tmp
+        kept = [p for p in kept if not any(q in p.parents for q in kept)]
+        for path in kept:
+            wrap += ["--ro-bind", str(path), str(path)]
+        for path in self.hidden:  # under /tmp only what was bound back needs hiding again
+            if tmp not in path.parents or any(k in path.parents for k in kept):
                 wrap += ["--tmpfs", str(path)]
         wrap += ["--bind", str(work), str(work), "--chdir", str(work),
                  "--unshare-net", "--unshare-pid", "--unshare-ipc", "--unshare-uts",
