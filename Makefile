@@ -32,7 +32,7 @@ lab: $(STAMP)
 # Exercise templates (check cells print "not yet implemented") and the instructor's solutions.
 EXERCISES = $(wildcard notebooks/exercises/*.ipynb) $(wildcard instructor/solutions/*.ipynb)
 NOTEBOOKS = $(wildcard notebooks/*.ipynb) $(EXERCISES)
-PYTEST_ARGS = -n 2 --dist loadfile tests $(NOTEBOOKS) --nbval --nbval-sanitize-with tests/nbval_sanitize.cfg
+PYTEST_ARGS = -n 2 --dist loadfile tests $(NOTEBOOKS) --nbval --nbval-sanitize-with tests/nbval_sanitize.cfg --durations=15
 
 test: $(STAMP)
 	$(PY) -m pytest $(PYTEST_ARGS)

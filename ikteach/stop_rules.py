@@ -45,8 +45,12 @@ def motion(J, delta_theta):
 def step_size(rule, jacobian_at_theta, delta_theta):
     """The size the stall rule compares with stall_tol (rule: a traced index into STOP_RULES).
 
-    jacobian_at_theta() is only evaluated for the "motion" rule.
+    jacobian_at_theta() is only evaluated for the "motion" rule. Outside a trace (an eager
+    solve with a numpy step function) the rule is a plain number: a Python branch, since an
+    eager lax.cond on a fresh lambda compiles anew on every call.
     """
+    if not isinstance(rule, jax.core.Tracer):
+        return motion(jacobian_at_theta(), delta_theta) if int(rule) == 1 else joint_steps(delta_theta)
     return jax.lax.cond(rule == 1, lambda: motion(jacobian_at_theta(), delta_theta),
                         lambda: joint_steps(delta_theta))
 

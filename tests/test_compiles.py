@@ -56,3 +56,19 @@ def test_end_path_in_blocks_equals_fk_row_by_row(k):
     thetas = np.random.default_rng(k).normal(size=(k, 3))
     want = np.array([np.asarray(ik.fk(ARM, q)) for q in thetas])
     np.testing.assert_allclose(end_path(ARM, thetas), want, atol=1e-12)
+
+
+def _numpy_stop_step(J, e):  # a student's step: numpy, with the exercise-5 stop rule
+    delta = 0.1 * np.asarray(J).T @ np.asarray(e)
+    if np.abs(delta).sum() < 1e-3:
+        raise ik.StopSolve()
+    return delta
+
+
+@pytest.mark.parametrize("stop_rule", ["joint_steps", "motion"])
+def test_eager_solves_with_a_python_step_compile_nothing_new(stop_rule):
+    ik.solve(ARM, [2.5, 0.5], START, method=_numpy_stop_step, max_iter=50, stop_rule=stop_rule)
+    before = len(COMPILES)
+    for target in ([2.0, 1.0], [4.0, 0.5], [1.0, -1.5]):  # reachable and out of reach
+        ik.solve(ARM, target, START, method=_numpy_stop_step, max_iter=50, stop_rule=stop_rule)
+    assert len(COMPILES) == before, COMPILES[before:]
