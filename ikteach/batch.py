@@ -4,6 +4,7 @@ Targets differ in how many iterations they need. A vmapped while-loop would keep
 lane busy until the slowest target is done, so instead a fixed number of slots run side
 by side and a slot whose target has finished takes the next target from the queue:
 the work is the sum of the iterations, not the batch size times the largest count.
+Slots are refilled every STEPS_PER_REFILL steps; a slot that finishes in between idles.
 """
 import dataclasses
 from functools import partial
@@ -19,6 +20,7 @@ from .solve import (DEFAULT_DAMPING, RUNNING, STATUSES, advance, check_problem, 
                     resolve_method, status_counts, with_extras)
 
 SLOTS = 1024  # targets in flight at once
+STEPS_PER_REFILL = 4  # loop steps between refills (a refill costs more than a step)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -54,10 +56,15 @@ def _run_queue(method, task, arm, targets, thetas0, settings, max_iter, slots):
         state = start(thetas0[jnp.minimum(index, count - 1)])
         return state._replace(status=jnp.where(index < count, state.status, -1))
 
+    def advance_running(_, state_and_target):
+        state, target = state_and_target
+        return _select(state.status == RUNNING, step(target, state), state), target
+
     def body(carry):
         index, state, out, queued = carry
         running = state.status == RUNNING
-        state = _select(running, step(targets[jnp.minimum(index, count - 1)], state), state)
+        state, _ = jax.lax.fori_loop(0, STEPS_PER_REFILL, advance_running,
+                                     (state, targets[jnp.minimum(index, count - 1)]))
         done = running & (state.status != RUNNING)
         out = jax.tree_util.tree_map(
             lambda o, x: o.at[jnp.where(done, index, count)].set(x, mode="drop"), out, state)

@@ -9,15 +9,15 @@ from .chain import Chain
 from .kinematics import joint_frames
 
 
-def ccd_angle(w, p, x, t):
-    """The turn about the unit axis w through p that brings x closest to t.
+def ccd_angle(z, p, x, t):
+    """The turn about the unit axis z through p that brings x closest to t.
 
-    With u, v the parts of x - p and t - p perpendicular to w:
-    angle = atan2(w . (u x v), u . v)   (0 when u or v vanishes).
+    With u, v the parts of x - p and t - p perpendicular to z:
+    angle = atan2(z . (u x v), u . v)   (0 when u or v vanishes).
     """
-    u = (x - p) - jnp.dot(x - p, w) * w
-    v = (t - p) - jnp.dot(t - p, w) * w
-    return jnp.arctan2(jnp.dot(w, jnp.cross(u, v)), jnp.dot(u, v))
+    u = (x - p) - jnp.dot(x - p, z) * z
+    v = (t - p) - jnp.dot(t - p, z) * z
+    return jnp.arctan2(jnp.dot(z, jnp.cross(u, v)), jnp.dot(u, v))
 
 
 def as_point3(arm, target):
@@ -26,7 +26,7 @@ def as_point3(arm, target):
 
 
 def ccd_sweep(arm, target, theta):
-    """One CCD iteration: for i = n-1, ..., 0, theta_i += ccd_angle(w_i, p_i, x_end, target)."""
+    """One CCD iteration: for i = n-1, ..., 0, theta_i += ccd_angle(z_i, p_i, x_end, target)."""
     t = as_point3(arm, target)
     n = arm.n_joints
 

@@ -15,6 +15,11 @@ def jacobian(arm, theta, full=False):
     (6, n) for a spatial chain, (3, n) for a planar arm (x, y and the angle about z).
     """
     positions, axes, _ = joint_frames(arm, theta)
+    return jacobian_from_frames(arm, positions, axes, full)
+
+
+def jacobian_from_frames(arm, positions, axes, full=False):
+    """The geometric Jacobian from joint_frames' positions p_0..p_n and axes z_i."""
     linear = jnp.cross(axes, positions[-1] - positions[:-1]).T
     if not full:
         return linear[: arm.dim]

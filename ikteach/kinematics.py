@@ -4,9 +4,10 @@ import jax.numpy as jnp
 import numpy as np
 
 
-def skew(w):
-    """The cross-product matrix [w]x, so that [w]x v = w x v."""
-    return jnp.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+def skew(omega):
+    """The cross-product matrix [omega]x, so that [omega]x v = omega x v."""
+    o = omega
+    return jnp.array([[0.0, -o[2], o[1]], [o[2], 0.0, -o[0]], [-o[1], o[0], 0.0]])
 
 
 def rotation_about(axis, angle):
@@ -17,18 +18,18 @@ def rotation_about(axis, angle):
 
 @jax.jit
 def joint_frames(arm, theta):
-    """World joint positions p_0..p_n (p_n the end effector), world axes w_0..w_{n-1}
+    """World joint positions p_0..p_n (p_n the end effector), world axes z_0..z_{n-1}
     and the end effector's rotation R.
 
-    p_{i+1} = p_i + R_i o_i,  R_i = R_{i-1} Rot(a_i, theta_i),  w_i = R_{i-1} a_i.
+    p_{i+1} = p_i + R_i o_i,  R_i = R_{i-1} Rot(a_i, theta_i),  z_i = R_{i-1} a_i.
     """
     def link(carry, joint):
         R, p = carry
         axis, offset, angle = joint
-        w = R @ axis              # joint axis in the world, before the joint turns
+        z = R @ axis              # joint axis in the world, before the joint turns
         R = R @ rotation_about(axis, angle)
         p = p + R @ offset        # the next joint (or the end effector)
-        return (R, p), (p, w)
+        return (R, p), (p, z)
 
     theta = jnp.asarray(theta, dtype=float)
     if theta.shape != (arm.axes.shape[0],):

@@ -136,9 +136,34 @@ class State(NamedTuple):
     trace_error: jax.Array
 
 
+@dataclasses.dataclass(frozen=True)
+class _Linearized:
+    """The task with J(theta) at this iteration's theta already computed (read, not redone)."""
+    task: object
+    theta: object
+    J: object
+
+    def jacobian(self, arm, theta):
+        return self.J if theta is self.theta else self.task.jacobian(arm, theta)
+
+    def __getattr__(self, name):  # everything else is the task's
+        if name == "task":
+            raise AttributeError(name)
+        return getattr(self.task, name)
+
+
+def linearize(task, arm, target, theta):
+    """e(theta) and a task that hands back J(theta): one walk of the chain where the task
+    offers error_and_jacobian (position targets on chains), two calls otherwise."""
+    if not hasattr(task, "error_and_jacobian"):
+        return task.error(arm, target, theta), task
+    e, J = task.error_and_jacobian(arm, target, theta)
+    return e, _Linearized(task, theta, J)
+
+
 def advance(method, task, arm, target, settings, max_iter, state):
     """One pass of the loop described in the module docstring."""
-    e = task.error(arm, target, state.theta)
+    e, task = linearize(task, arm, target, state.theta)
     err = jnp.linalg.norm(e)
     trace_error = state.trace_error.at[state.i].set(err) if state.trace_error.size else state.trace_error
     status = jnp.select(

@@ -7,8 +7,8 @@ built in; other tasks (pose targets, trees) add themselves to TASKS.
 import dataclasses
 
 from .chain import Chain, reach
-from .jacobian import jacobian
-from .kinematics import fk
+from .jacobian import jacobian, jacobian_from_frames
+from .kinematics import fk, joint_frames
 from .tree import TreeTask
 
 
@@ -30,6 +30,11 @@ class PositionTask:
 
     def jacobian(self, arm, theta):
         return jacobian(arm, theta)
+
+    def error_and_jacobian(self, arm, target, theta):
+        """e and J from one walk of the chain (the solve loop needs both every iteration)."""
+        positions, axes, _ = joint_frames(arm, theta)
+        return target - positions[-1, : arm.dim], jacobian_from_frames(arm, positions, axes)
 
     def length_scale(self, arm):
         return float(reach(arm))

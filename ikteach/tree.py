@@ -6,7 +6,7 @@ A tree of n revolute joints and m end effectors is stored in its rest pose (thet
   parents[j]            index of joint j's parent joint, -1 for a root (parents[j] < j),
   effectors[k]          world position of end effector k at rest,
   effector_parents[k]   the joint that carries effector k.
-Turning joint j turns everything below it about the line through p_j along w_j.
+Turning joint j turns everything below it about the line through p_j along z_j.
 """
 import dataclasses
 
@@ -99,7 +99,7 @@ def tree_frames(arm, theta):
     """World joint positions (n, 3), world axes (n, 3) and effector positions (m, 3).
 
     Walking parents first:  R_j = R_parent Rot(a_j, theta_j),
-    p_j = p_parent + R_parent (rest_j - rest_parent),  w_j = R_parent a_j,
+    p_j = p_parent + R_parent (rest_j - rest_parent),  z_j = R_parent a_j,
     effector k on joint j:  x_k = p_j + R_j (rest_k - rest_j).
     """
     theta = jnp.asarray(theta, dtype=float)
@@ -119,11 +119,11 @@ def tree_frames(arm, theta):
         Rj = Rp @ rotation_about(axes[j], theta[j])
         return (R_all.at[j].set(Rj), p_all.at[j].set(pj)), Rp @ axes[j]
 
-    (R, p), w = jax.lax.scan(visit, (jnp.zeros((n, 3, 3)), jnp.zeros((n, 3))),
+    (R, p), z = jax.lax.scan(visit, (jnp.zeros((n, 3, 3)), jnp.zeros((n, 3))),
                              (jnp.arange(n), jnp.asarray(parents)))
     on = np.asarray(arm.effector_parents)
     x = p[on] + jnp.einsum("kab,kb->ka", R[on], jnp.asarray(arm.effectors) - rest[on])
-    return p, w, x
+    return p, z, x
 
 
 @jax.jit
@@ -136,10 +136,10 @@ def tree_fk(arm, theta):
 def tree_jacobian(arm, theta):
     """The stacked Jacobian, one block of 3 rows per end effector: shape (3m, n).
 
-    Block k, column j is w_j x (x_k - p_j) when joint j moves effector k, else 0.
+    Block k, column j is z_j x (x_k - p_j) when joint j moves effector k, else 0.
     """
-    p, w, x = tree_frames(arm, theta)
-    blocks = jnp.cross(w[None, :, :], x[:, None, :] - p[None, :, :])  # (m, n, 3)
+    p, z, x = tree_frames(arm, theta)
+    blocks = jnp.cross(z[None, :, :], x[:, None, :] - p[None, :, :])  # (m, n, 3)
     blocks = jnp.where(jnp.asarray(ancestors(arm))[:, :, None], blocks, 0.0)
     return jnp.transpose(blocks, (0, 2, 1)).reshape(3 * arm.n_effectors, arm.n_joints)
 

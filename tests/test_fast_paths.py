@@ -1,0 +1,82 @@
+"""The solver's specialised arithmetic equals the general path it replaces: the closed-form
+small solve of DLS, e and J from one walk of the chain, and refilling slots every few steps."""
+import jax
+import numpy as np
+import pytest
+
+import ikteach as ik
+from ikteach import batch
+from ikteach.small_solve import solve_small
+from ikteach.solve import linearize
+from ikteach.tasks import PositionTask
+
+RNG = np.random.default_rng(11)
+
+
+@pytest.mark.parametrize("m", [1, 2, 3, 4, 6])
+def test_solve_small_equals_lu(m):
+    for _ in range(10):
+        J = RNG.normal(size=(m, 7))
+        A = J @ J.T + 0.1 * np.eye(m)
+        b = RNG.normal(size=m)
+        np.testing.assert_allclose(solve_small(A, b), np.linalg.solve(A, b), rtol=1e-10,
+                                   atol=1e-12)
+
+
+def test_solve_small_of_a_singular_matrix_is_not_finite():
+    """With lambda = 0 at a singular pose DLS must fail loudly (the loop then says diverged)."""
+    x = solve_small(np.zeros((2, 2)), np.ones(2))
+    assert not np.all(np.isfinite(x))
+
+
+def test_dls_step_equals_the_normal_equations():
+    for lengths, dim in (([1.0, 1.0, 1.0], 2), ([0.5, 1.2, 0.3, 0.9], 2)):
+        arm = ik.planar_chain(lengths)
+        J = ik.jacobian(arm, RNG.normal(size=len(lengths)))
+        e = RNG.normal(size=dim)
+        np.testing.assert_allclose(ik.dls_step(J, e, 0.5), ik.dls_step_normal(J, e, 0.5),
+                                   atol=1e-12)
+    J = np.asarray(ik.jacobian(ik.ur5(), RNG.normal(size=6)))  # m = 3: the adjugate
+    e = RNG.normal(size=3)
+    np.testing.assert_allclose(ik.dls_step(J, e, 0.3), ik.dls_step_normal(J, e, 0.3), atol=1e-12)
+
+
+def one_walk(task, arm, target, theta):
+    e, linearized = linearize(task, arm, target, theta)
+    return e, linearized.jacobian(arm, theta)
+
+
+@pytest.mark.parametrize("arm", [ik.planar_chain([1.0, 0.7, 0.4], base=(0.2, -0.1)), ik.ur5()],
+                         ids=["planar", "ur5"])
+def test_one_walk_of_the_chain_gives_the_same_e_and_J_as_two(arm):
+    task = PositionTask()
+    for _ in range(5):
+        theta = RNG.normal(scale=2.0, size=arm.n_joints)
+        target = RNG.normal(size=arm.dim)
+        e, J = jax.jit(lambda q: one_walk(task, arm, target, q))(theta)
+        np.testing.assert_allclose(e, task.error(arm, target, theta), rtol=0, atol=1e-13)
+        np.testing.assert_allclose(J, task.jacobian(arm, theta), rtol=0, atol=1e-13)
+
+
+def test_the_linearized_task_computes_J_afresh_at_another_theta():
+    arm, task = ik.planar_chain([1.0, 1.0]), PositionTask()
+    theta, other = np.array([0.3, 0.4]), np.array([1.0, -0.5])
+    _, linearized = linearize(task, arm, np.array([1.0, 1.0]), theta)
+    np.testing.assert_array_equal(linearized.jacobian(arm, other), ik.jacobian(arm, other))
+    assert linearized.length_scale(arm) == task.length_scale(arm)  # the rest is the task's
+
+
+@pytest.mark.parametrize("steps", [1, 3])
+def test_refilling_every_few_steps_changes_no_result(monkeypatch, steps):
+    arm = ik.planar_chain([1.0, 1.0, 1.0])
+    targets = RNG.uniform(-3.3, 3.3, size=(300, 2))
+    kw = dict(method="dls", tol=1e-3, max_iter=60)
+    default = ik.solve_batch(arm, targets, [0.3, 0.3, 0.3], **kw)
+    monkeypatch.setattr(batch, "STEPS_PER_REFILL", steps)
+    monkeypatch.setattr(batch, "SLOTS", 64)  # far fewer slots than targets: many refills
+    batch._run_queue.clear_cache()
+    other = ik.solve_batch(arm, targets, [0.3, 0.3, 0.3], **kw)
+    batch._run_queue.clear_cache()
+    np.testing.assert_array_equal(other.theta, default.theta)
+    np.testing.assert_array_equal(other.iterations, default.iterations)
+    np.testing.assert_array_equal(other.status, default.status)
