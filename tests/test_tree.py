@@ -118,3 +118,19 @@ def test_bad_tree_input_names_the_parameter():
         ik.solve(Y, np.zeros(3), np.zeros(7))
     with pytest.raises(ValueError, match="method"):
         ik.solve(Y, np.zeros((2, 3)), np.zeros(7), method="ccd")
+
+
+def test_tree_animation_titles_each_frame_with_its_time_and_has_a_still():
+    from ikteach import plot, tree_plot
+
+    times = np.array([0.0, 0.25, 0.5])
+    targets = buss_trees.y_targets(times)
+    thetas = np.zeros((3, Y.n_joints))
+    anim = tree_plot.animate_tree(Y, thetas, targets, times=times, title="Y tree, SDLS")
+    assert list(anim.iterations) == [0, 1, 2] and anim.still == 2
+    ax = anim._fig.axes[0]
+    assert ax.get_title() == "Y tree, SDLS: t =  0.50 s"  # laid out at the last frame
+    assert {t.get_text() for t in ax.get_legend().get_texts()} >= {"end effectors", "targets"}
+    anim._draw_frame(1)
+    assert ax.get_title() == "Y tree, SDLS: t =  0.25 s"
+    assert plot.still_png(anim)[:8] == b"\x89PNG\r\n\x1a\n"
