@@ -1,0 +1,56 @@
+"""How long each lecture notebook takes to run top to bottom: cold (an empty compilation cache,
+what a student's first run costs) and warm (the same cache again: a second run, or a lecture
+after the course was opened once). Kernel start-up included.
+
+    .venv/bin/python benchmarks/notebook_times.py [notebooks/0*.ipynb ...]
+
+Goals (issue 9): each lecture notebook <= 15 s cold, <= 5 s with the cache warm.
+"""
+import argparse
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import nbformat
+from nbclient import NotebookClient
+
+from ikteach.notebook import CACHE_ENV
+
+ROOT = Path(__file__).resolve().parents[1]
+COLD_GOAL_S, WARM_GOAL_S = 15.0, 5.0
+
+
+def run_seconds(path, cache):
+    """Wall time of one top-to-bottom run in a fresh kernel using this compilation cache."""
+    nb = nbformat.read(path, as_version=4)
+    os.environ[CACHE_ENV] = cache  # the kernel inherits it; setup() turns the cache on there
+    t0 = time.perf_counter()
+    NotebookClient(nb, timeout=900, kernel_name="python3",
+                   resources={"metadata": {"path": str(path.parent)}}).execute()
+    return time.perf_counter() - t0
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("notebooks", nargs="*", type=Path)
+    args = ap.parse_args()
+    paths = args.notebooks or sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))
+    print(f"{os.cpu_count()} CPU cores; python {sys.version.split()[0]}")
+    print(f"| {'notebook':<36} | {'cold s':>7} | {'warm s':>7} | {'goal':>9} |")
+    print(f"|{'-' * 38}|{'-' * 9}|{'-' * 9}|{'-' * 11}|")
+    totals = [0.0, 0.0]
+    for path in paths:
+        with tempfile.TemporaryDirectory(prefix="ikteach-cache-") as cache:
+            cold = run_seconds(path, cache)
+            warm = run_seconds(path, cache)
+        totals[0] += cold
+        totals[1] += warm
+        ok = "ok" if cold <= COLD_GOAL_S and warm <= WARM_GOAL_S else "SLOW"
+        print(f"| {path.name:<36} | {cold:>7.1f} | {warm:>7.1f} | {ok:>9} |", flush=True)
+    print(f"| {'total':<36} | {totals[0]:>7.1f} | {totals[1]:>7.1f} | {'':>9} |")
+
+
+if __name__ == "__main__":
+    main()
