@@ -56,15 +56,12 @@ def _run_queue(method, task, arm, targets, thetas0, settings, max_iter, slots):
         state = start(thetas0[jnp.minimum(index, count - 1)])
         return state._replace(status=jnp.where(index < count, state.status, -1))
 
-    def advance_running(_, state_and_target):
-        state, target = state_and_target
-        return _select(state.status == RUNNING, step(target, state), state), target
-
     def body(carry):
         index, state, out, queued = carry
         running = state.status == RUNNING
-        state, _ = jax.lax.fori_loop(0, STEPS_PER_REFILL, advance_running,
-                                     (state, targets[jnp.minimum(index, count - 1)]))
+        target = targets[jnp.minimum(index, count - 1)]
+        state = jax.lax.fori_loop(
+            0, STEPS_PER_REFILL, lambda _, s: _select(s.status == RUNNING, step(target, s), s), state)
         done = running & (state.status != RUNNING)
         out = jax.tree_util.tree_map(
             lambda o, x: o.at[jnp.where(done, index, count)].set(x, mode="drop"), out, state)
