@@ -25,6 +25,7 @@ def as_point3(arm, target):
     return jnp.concatenate([target, jnp.zeros(3 - arm.dim)]) if arm.dim == 2 else target
 
 
+@jax.jit
 def ccd_sweep(arm, target, theta):
     """One CCD iteration: for i = n-1, ..., 0, theta_i += ccd_angle(z_i, p_i, x_end, target)."""
     t = as_point3(arm, target)

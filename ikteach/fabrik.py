@@ -53,6 +53,7 @@ def fabrik_stretch(points, lengths, target):
     return points
 
 
+@jax.jit
 def fabrik_pass(points, lengths, target):
     """One FABRIK iteration on the points (stretch when the target is out of reach)."""
     points, lengths, target = jnp.asarray(points), jnp.asarray(lengths), jnp.asarray(target)

@@ -1,7 +1,9 @@
 """Jacobian transpose: step along the gradient of 1/2 ||e||^2 with Buss's optimal alpha."""
+import jax
 import jax.numpy as jnp
 
 
+@jax.jit
 def optimal_alpha(J, e):
     """alpha = <e, J J^T e> / <J J^T e, J J^T e>, the alpha minimising ||e - alpha J J^T e||.
 
@@ -14,6 +16,7 @@ def optimal_alpha(J, e):
     return jnp.where(vv > 0, jnp.dot(e, v) / safe, 0.0)
 
 
+@jax.jit
 def jt_step(J, e):
     """Jacobian-transpose step: delta_theta = alpha J^T e, alpha from optimal_alpha."""
     J, e = jnp.asarray(J), jnp.asarray(e)

@@ -1,9 +1,11 @@
 """Pseudoinverse step by the SVD, with a cut-off for small singular values."""
+import jax
 import jax.numpy as jnp
 
 DEFAULT_RCOND = 1e-6
 
 
+@jax.jit
 def pinv_step(J, e, rcond=DEFAULT_RCOND):
     """delta_theta = J^+ e = sum_i (u_i . e / sigma_i) v_i over sigma_i >= rcond * sigma_max.
 

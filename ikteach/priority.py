@@ -16,6 +16,7 @@ from ._validate import as_array, as_number
 RANK_RCOND = 1e-10  # singular values below RANK_RCOND * sigma_max count as zero (the null space)
 
 
+@jax.jit
 def damped_pinv(A, damping, scale=None):
     """A's damped pseudoinverse V diag(sigma / (sigma^2 + lambda^2)) U^T = A^T (A A^T + lambda^2 I)^-1.
 
@@ -29,6 +30,7 @@ def damped_pinv(A, damping, scale=None):
     return Vt.T @ (inv[:, None] * U.T)
 
 
+@jax.jit
 def null_projector(A):
     """N = I - A+ A: projects onto the null space of A (A N = 0), from A's SVD."""
     _, sigma, Vt = jnp.linalg.svd(A, full_matrices=True)
@@ -56,6 +58,12 @@ def priority_step(J1, e1, J2, e2, damping):
     secondary task asks for.
     """
     J1, e1, J2, e2 = _check_levels(J1, e1, J2, e2, damping)
+    return _two_levels(J1, e1, J2, e2, damping)
+
+
+@jax.jit
+def _two_levels(J1, e1, J2, e2, damping):
+    # compiled once per shape: called op by op, every SVD and product compiled on its own
     return multilevel_step([(J1, e1), (J2, e2)], damping)
 
 

@@ -15,6 +15,7 @@ ClampMaxAbs(w, d) scales w down so that max_l |w_l| <= d (ik.cap_step). The pape
 gamma_max = pi/4; so no joint ever turns by more than gamma_max in one step.
 """
 import dataclasses
+import functools
 
 import jax
 import jax.numpy as jnp
@@ -42,6 +43,7 @@ def sdls_gamma(U, sigma, Vt, J, gamma_max, block):
     return gamma_max * jnp.minimum(1.0, ratio)
 
 
+@functools.partial(jax.jit, static_argnames="block")
 def sdls_step(J, e, gamma_max=GAMMA_MAX, block=None):
     """delta_theta = ClampMaxAbs(sum_i ClampMaxAbs((u_i.e / sigma_i) v_i, gamma_i), gamma_max).
 

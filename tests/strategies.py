@@ -40,11 +40,24 @@ def matrices(draw, max_rows=6, max_cols=10):
     return rng.normal(size=(m, n)), rng.normal(size=m)
 
 
-@st.composite
-def random_trees(draw, max_joints=8, max_effectors=3):
-    n = draw(st.integers(1, max_joints))
-    m = draw(st.integers(1, max_effectors))
-    rng = np.random.default_rng(draw(st.integers(0, 2**31 - 1)))
+def _topology(n, m, seed):
+    """Random parents (each joint hangs from an earlier one) and effector parents."""
+    rng = np.random.default_rng(seed)
     parents = [-1] + [int(rng.integers(0, j)) for j in range(1, n)]
-    return ik.tree(rng.normal(size=(n, 3)), rng.normal(size=(n, 3)), parents,
-                   rng.normal(size=(m, 3)), rng.integers(0, n, size=m).tolist())
+    return tuple(parents), tuple(rng.integers(0, n, size=m).tolist())
+
+
+# A tree's shape is static (one compile each), so shapes come from a fixed pool of random ones,
+# 1 to 8 joints and 1 to 3 effectors, plus a chain and a star; the geometry is free.
+TREE_SHAPES = [_topology(n, m, seed) for seed, (n, m) in
+               enumerate([(1, 1), (2, 2), (3, 1), (4, 3), (5, 2), (6, 3), (8, 1), (8, 3)])]
+TREE_SHAPES += [(tuple(range(-1, 5)), (5, 2)), ((-1,) + (0,) * 5, (1, 3, 5))]
+
+
+@st.composite
+def random_trees(draw, shapes=TREE_SHAPES):
+    parents, effector_parents = draw(st.sampled_from(shapes))
+    rng = np.random.default_rng(draw(st.integers(0, 2**31 - 1)))
+    n, m = len(parents), len(effector_parents)
+    return ik.tree(rng.normal(size=(n, 3)), rng.normal(size=(n, 3)), list(parents),
+                   rng.normal(size=(m, 3)), list(effector_parents))

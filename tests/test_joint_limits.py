@@ -9,6 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import ikteach as ik
+import strategies
 from strategies import planar_arms
 
 # Two tree shapes (parents, effector parents): the geometry is random, the shapes few, so
@@ -16,13 +17,9 @@ from strategies import planar_arms
 TOPOLOGIES = [((-1, 0, 1, 1, 3), (2, 4)), ((-1, 0, 0, 2, 3, 4), (1, 5))]
 
 
-@st.composite
-def random_trees(draw):
-    parents, effector_parents = draw(st.sampled_from(TOPOLOGIES))
-    rng = np.random.default_rng(draw(st.integers(0, 2**31 - 1)))
-    n, m = len(parents), len(effector_parents)
-    return ik.tree(rng.normal(size=(n, 3)), rng.normal(size=(n, 3)), parents,
-                   rng.normal(size=(m, 3)), effector_parents)
+def random_trees():
+    return strategies.random_trees(shapes=TOPOLOGIES)
+
 
 MODES = ["clamp", "clamping_loop"]
 SLICING = {"dynamic_slice", "slice"}
