@@ -38,7 +38,7 @@ def graded(tmp_path_factory):
         path.unlink(missing_ok=True)
     out = base / "out" / "grades.csv"
     run = subprocess.run([sys.executable, "-m", "ikteach.grade", str(subs), "--out", str(out),
-                          "--timeout", "20", "--jobs", "2"],
+                          "--timeout", "10", "--jobs", "2"],
                          capture_output=True, text=True, timeout=1500, cwd=base)
     assert run.returncode == 0, run.stderr[-3000:]
     rows = {r["student"]: r for r in csv.DictReader(out.open())}
@@ -100,9 +100,9 @@ HOSTILE = [
     ("write_outside", 1, 10, "passed, 10/10"),
     ("fork_storm", 2, 10, "passed, 10/10"),
     ("memory_hog", 4, 10, "raised MemoryError"),
-    ("sigint_loop", 5, 10, "did not finish within the notebook's time limit (20 s)"),
+    ("sigint_loop", 5, 10, "did not finish within the notebook's time limit (10 s)"),
     ("huge_output", 1, 10, "passed, 10/10"),
-    ("hostile", 3, 10, "did not finish within the notebook's time limit (20 s)"),
+    ("hostile", 3, 10, "did not finish within the notebook's time limit (10 s)"),
     ("not_json", 1, 0, "it is not JSON"),
     ("no_functions", 3, 0, "`pinv_step` not found in the notebook"),
 ]
