@@ -18,6 +18,7 @@ from .sdls import GAMMA_MAX
 from .levels import DEFAULT_REST_GAIN
 from .solve import (DEFAULT_DAMPING, RUNNING, STATUSES, advance, check_problem, initial_state,
                     resolve_method, status_counts, with_extras)
+from . import xla
 
 SLOTS = 1024  # targets in flight at once
 STEPS_PER_REFILL = 4  # loop steps between refills (a refill costs more than a step)
@@ -45,7 +46,7 @@ def _select(mask, a, b):
         lambda x, y: jnp.where(mask.reshape(mask.shape + (1,) * (x.ndim - 1)), x, y), a, b)
 
 
-@partial(jax.jit, static_argnames=("method", "task", "max_iter", "slots"))
+@partial(xla.jit, static_argnames=("method", "task", "max_iter", "slots"))
 def _run_queue(method, task, arm, targets, thetas0, settings, max_iter, slots):
     """Solve every target; `slots` of them in flight, refilled from the queue as they finish."""
     count = targets.shape[0]

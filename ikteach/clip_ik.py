@@ -15,6 +15,7 @@ import numpy as np
 from ._validate import as_array, as_count, as_number
 from .solve import METHODS, STATUSES, Settings, run_loop
 from .tree import TreeTask, tree_jacobian, tree_size
+from . import xla
 
 
 @dataclasses.dataclass(frozen=True)
@@ -26,7 +27,7 @@ class MaskedTreeTask(TreeTask):
         return tree_jacobian(arm, theta) * jnp.asarray(self.mask)
 
 
-@partial(jax.jit, static_argnames=("task", "max_iter"))
+@partial(xla.jit, static_argnames=("task", "max_iter"))
 def _solve_clip(task, arm, targets, theta, settings, max_iter):
     method = METHODS["dls"]
 

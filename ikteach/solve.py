@@ -31,6 +31,7 @@ from .limits import cap_step, clamp_error
 from .pinv import DEFAULT_RCOND, pinv_step
 from .tasks import task_for
 from . import stop_rules
+from . import xla
 
 STATUSES = ("running", "converged", "stalled", "max_iter", "diverged", "slow")  # append only
 RUNNING, CONVERGED, STALLED, MAX_ITER, DIVERGED, SLOW = range(6)
@@ -206,7 +207,7 @@ def run_loop(method, task, arm, target, theta0, settings, max_iter, record):
                               initial_state(theta0, max_iter, record))
 
 
-@partial(jax.jit, static_argnames=("method", "task", "max_iter", "record"))
+@partial(xla.jit, static_argnames=("method", "task", "max_iter", "record"))
 def _run_jit(method, task, arm, target, theta0, settings, max_iter, record):
     """The compiled loop, run as a batch of one so that its arithmetic is the batched
     arithmetic of solve_batch: the same target gives the same iterates to the last bit."""

@@ -19,6 +19,7 @@ from .sdls import GAMMA_MAX
 from .levels import DEFAULT_REST_GAIN
 from .solve import DEFAULT_DAMPING, Settings, resolve_method, with_extras
 from .tasks import task_for
+from . import xla
 
 
 @dataclasses.dataclass(frozen=True)
@@ -45,7 +46,7 @@ def clamp_blocks(e, block, d_max):
     return (parts * scale).reshape(-1)
 
 
-@partial(jax.jit, static_argnames=("method", "task"))
+@partial(xla.jit, static_argnames=("method", "task"))
 def _track(method, task, arm, targets, theta0, settings, d_max):
     block = getattr(task, "block_size", None)
 

@@ -16,6 +16,7 @@ from .kinematics import end_path  # noqa: F401  (ws.end_path, used by the notebo
 from .jitter import jitter_per_step
 from .solve import status_counts
 from .track import track as follow
+from . import xla
 
 STATUS_COLORS = {"converged": "#55a868", "stalled": "#dd8452", "max_iter": "#c44e52",
                  "diverged": "#222222", "slow": "#8172b3"}
@@ -83,7 +84,7 @@ def sweep(arm, grid, theta0, method="dls", **kwargs):
                     grid.image(res.theta), grid.image(res.error))
 
 
-@jax.jit
+@xla.jit
 def _sigma_min(arm, thetas):
     return jax.vmap(lambda q: jnp.linalg.svd(jacobian(arm, q), compute_uv=False)[-1])(thetas)
 
