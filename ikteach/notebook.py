@@ -2,6 +2,7 @@
 import os
 import pathlib
 import random
+import sys
 
 import numpy as np
 
@@ -16,6 +17,7 @@ def setup(seed=SEED, pyvista=None):
     pyvista="static" shows 3-D scenes as PNG images, "interactive" as pyvista's live trame
     view (needs the `3d` extra); None (default) reads $IKTEACH_PYVISTA, else picks live 3-D
     when trame is installed and a display is present. Headless, pyvista renders off screen.
+    pyvista itself loads only when a notebook first draws in 3-D (ik.scene).
     Compiled solvers are kept on disk between runs (see compilation_cache).
     """
     np.set_printoptions(precision=4, suppress=True, floatmode="fixed", linewidth=100)
@@ -33,7 +35,7 @@ def setup(seed=SEED, pyvista=None):
         "animation.embed_limit": 4.0,  # MB
         "svg.hashsalt": "ikteach",
     })
-    _setup_pyvista(pyvista)
+    choose_pyvista(pyvista)
     compilation_cache()
     _setup_alt_text()
     print_versions()
@@ -81,6 +83,29 @@ def pyvista_backend(choice, headless):
     if choice is None:
         return "static" if headless else "trame"
     return "trame" if choice == "interactive" else "static"
+
+
+_NOT_CHOSEN = object()
+_pyvista_choice = _NOT_CHOSEN  # what setup() asked for, until pyvista loads
+
+
+def choose_pyvista(choice=None):
+    """Check and keep the 3-D backend choice: set now if pyvista is loaded, else when ik.scene
+    first loads it (importing pyvista costs about 0.4 s; most notebooks draw nothing in 3-D)."""
+    global _pyvista_choice
+    pyvista_backend(choice or os.environ.get("IKTEACH_PYVISTA") or None, headless=True)
+    _pyvista_choice = choice
+    if "pyvista" in sys.modules:
+        apply_pyvista_choice()
+
+
+def apply_pyvista_choice():
+    """Set the backend setup() chose, once; called by ik.scene as it loads pyvista."""
+    global _pyvista_choice
+    if _pyvista_choice is _NOT_CHOSEN:
+        return None
+    choice, _pyvista_choice = _pyvista_choice, _NOT_CHOSEN
+    return _setup_pyvista(choice)
 
 
 def _setup_pyvista(choice=None):

@@ -22,6 +22,10 @@ STATIC_BACKENDS = (None, "static", "none")  # pv.global_theme.jupyter_backend va
 
 def _pv():
     import pyvista as pv
+
+    from .notebook import apply_pyvista_choice
+
+    apply_pyvista_choice()
     try:  # vtk's X11 warnings go straight to stderr; keep errors only
         import vtk
         vtk.vtkLogger.SetStderrVerbosity(vtk.vtkLogger.VERBOSITY_ERROR)

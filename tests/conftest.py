@@ -15,3 +15,4 @@ collect_ignore_glob = ["submissions/*"]
 from ikteach.notebook import compilation_cache  # noqa: E402
 
 compilation_cache()
+
