@@ -58,6 +58,8 @@ def animate_clips(rig, clips, titles, root, view="side", every=3, interval=100, 
     import matplotlib.pyplot as plt
     from matplotlib.animation import FuncAnimation
 
+    from .plot import fixed_layout
+
     i, j = _plane(view)
     clips, root = [np.asarray(c) for c in clips], np.asarray(root)
     top = max(c[..., j].max() for c in clips) + 10
@@ -78,7 +80,7 @@ def animate_clips(rig, clips, titles, root, view="side", every=3, interval=100, 
             if r == 0:
                 ax.set_title(title, fontsize=10)
             panels.append((ax, half, lines, dots, marks, clip))
-    fig.tight_layout()
+    fixed_layout(fig)
 
     def frame(f):
         out = []

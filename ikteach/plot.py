@@ -302,11 +302,19 @@ def animate_race(arm, results, target, max_frames=MAX_FRAMES, spacing="log", fig
     return _animation(fig, frame, ks, interval=300)
 
 
+def fixed_layout(fig):
+    """tight_layout once, then no layout engine: tight_layout leaves a placeholder engine, and
+    with any engine every savefig renders the figure twice (a dry run first), which doubled
+    the cost of every animation frame."""
+    fig.tight_layout()
+    fig.set_layout_engine(None)
+
+
 def _animation(fig, frame, ks, interval):
     """Lay the figure out at its last frame (the longest titles), wrap it in a FuncAnimation
     that remembers the iterations it shows and its still frame, and close the figure."""
     frame(len(ks) - 1)
-    fig.tight_layout()
+    fixed_layout(fig)
     anim = FuncAnimation(fig, frame, frames=len(ks), interval=interval, blit=False, repeat=True)
     anim.iterations = ks
     anim.still = len(ks) - 1

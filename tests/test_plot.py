@@ -111,3 +111,17 @@ def test_error_axis_has_enough_tick_labels(low, labels_at_least):
     labels = [t.get_text() for t in ax.get_yticklabels() if lo <= t.get_position()[1] <= hi]
     assert len([t for t in labels if t]) >= labels_at_least, labels
     plt.close(fig)
+
+
+def test_an_animation_renders_each_saved_frame_once(monkeypatch):
+    """No layout engine left behind: with one, every savefig renders twice (a dry run)."""
+    arm = ik.planar_chain([1.0, 1.0, 1.0])
+    res = ik.solve(arm, [1.5, 1.0], [0.3, 0.3, 0.3], method="jt")
+    anim = plot.animate_solve(arm, res, [1.5, 1.0])
+    assert anim._fig.get_layout_engine() is None
+    renders = []
+    original = matplotlib.figure.Figure.draw
+    monkeypatch.setattr(matplotlib.figure.Figure, "draw",
+                        lambda fig, renderer: renders.append(1) or original(fig, renderer))
+    html = anim.to_jshtml()
+    assert len(renders) == html.count("data:image/png") == len(anim.iterations)
