@@ -37,6 +37,9 @@ def error_lines(cells):
 
 
 def run(path, timeout):
+    # jsonschema (under nbformat) imports rfc3987_syntax where installed, which builds a
+    # grammar at import: 1.1 s of every notebook's run, for an "iri" format no notebook uses
+    sys.modules.setdefault("rfc3987_syntax", None)
     import nbformat
     from jupyter_core.utils import ensure_async, run_sync
     from nbclient import NotebookClient
