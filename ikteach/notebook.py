@@ -93,8 +93,7 @@ def choose_pyvista(choice=None):
     """Check and keep the 3-D backend choice: set now if pyvista is loaded, else when ik.scene
     first loads it (importing pyvista costs about 0.4 s; most notebooks draw nothing in 3-D)."""
     global _pyvista_choice
-    pyvista_backend(choice or os.environ.get("IKTEACH_PYVISTA") or None, headless=True)
-    _pyvista_choice = choice
+    _pyvista_choice = _checked_choice(choice)
     if "pyvista" in sys.modules:
         apply_pyvista_choice()
 
@@ -108,10 +107,16 @@ def apply_pyvista_choice():
     return _setup_pyvista(choice)
 
 
+def _checked_choice(choice):
+    """The choice, else $IKTEACH_PYVISTA, else None; a bad one fails before pyvista loads."""
+    choice = choice or os.environ.get("IKTEACH_PYVISTA") or None
+    pyvista_backend(choice, headless=True)
+    return choice
+
+
 def _setup_pyvista(choice=None):
     """Set pyvista's Jupyter backend (static unless trame is installed); return its name."""
-    choice = choice or os.environ.get("IKTEACH_PYVISTA") or None
-    pyvista_backend(choice, headless=True)  # a bad choice fails before pyvista loads
+    choice = _checked_choice(choice)
     try:
         import pyvista as pv
     except ImportError:

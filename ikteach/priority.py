@@ -58,12 +58,6 @@ def priority_step(J1, e1, J2, e2, damping):
     secondary task asks for.
     """
     J1, e1, J2, e2 = _check_levels(J1, e1, J2, e2, damping)
-    return _two_levels(J1, e1, J2, e2, damping)
-
-
-@jax.jit
-def _two_levels(J1, e1, J2, e2, damping):
-    # compiled once per shape: called op by op, every SVD and product compiled on its own
     return multilevel_step([(J1, e1), (J2, e2)], damping)
 
 
@@ -87,6 +81,7 @@ def _check_levels(J1, e1, J2, e2, damping):
     return tuple(jnp.asarray(x, dtype=float) for x in (J1, e1, J2, e2))
 
 
+@jax.jit
 def multilevel_step(levels, damping):
     """delta for levels [(J_1, e_1), (J_2, e_2), ...], level k solved in the null space of
     the stacked Jacobians of levels 1..k-1:  delta_k = delta_{k-1} + N_{<k} (J_k N_{<k})+ (e_k - J_k delta_{k-1})."""

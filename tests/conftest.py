@@ -15,4 +15,3 @@ collect_ignore_glob = ["submissions/*"]
 from ikteach.notebook import compilation_cache  # noqa: E402
 
 compilation_cache()
-
