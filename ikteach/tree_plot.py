@@ -52,7 +52,7 @@ def animate_tree(arm, thetas, targets, plane=(0, 1), limits=((-2.5, 4.0), (-1.0,
         effs.set_data(x[:, i], x[:, j])
         tgt.set_data(targets[k][:, i], targets[k][:, j])
         when = f"t = {times[k]:5.2f} s" if times is not None else f"frame {k}"
-        ax.set_title(f"{title}: {when}", fontsize=9)
-        return (*lines, joints, effs, tgt)
+        heading = ax.set_title(f"{title}: {when}", fontsize=9)
+        return (*lines, joints, effs, tgt, heading)
 
     return _animation(fig, frame, np.arange(len(thetas)), interval=interval)

@@ -125,3 +125,68 @@ def test_an_animation_renders_each_saved_frame_once(monkeypatch):
                         lambda fig, renderer: renders.append(1) or original(fig, renderer))
     html = anim.to_jshtml()
     assert len(renders) == html.count("data:image/png") == len(anim.iterations)
+
+
+def _png_pixels(png):
+    import io
+
+    from PIL import Image
+
+    return np.asarray(Image.open(io.BytesIO(png)).convert("RGBA"))
+
+
+def _animation(kind):
+    from ikteach import buss_trees, tree_plot
+
+    if kind == "solve":
+        res = ik.solve(ARM, [1.5, 1.0], [0.3, 0.3, 0.3], method="jt")
+        return plot.animate_solve(ARM, res, [1.5, 1.0])
+    if kind == "race":
+        race = {m: ik.solve(ARM, [3.5, 1.0], START, method=m, max_iter=60) for m in ("jt", "pinv", "dls")}
+        return plot.animate_race(ARM, race, [3.5, 1.0], max_frames=6)
+    tree = buss_trees.y_tree()
+    times = buss_trees.times(24)[::6]
+    thetas = np.linspace(0.0, 0.8, len(times))[:, None] * np.ones(tree.n_joints)
+    return tree_plot.animate_tree(tree, thetas, buss_trees.y_targets(times), times=times, title="Y")
+
+
+@pytest.mark.parametrize("kind", ["solve", "race", "tree"])
+def test_frame_pngs_match_full_redraws_except_where_moving_parts_overlap(kind, monkeypatch):
+    """frame_pngs draws the still parts once: each frame must equal a full redraw of it,
+    except inside the moving artists (painted over, not under, what stays still). A changing
+    artist left out of the frame function (a title, say) would differ outside them."""
+    anim = _animation(kind)
+    renders = []
+    original = matplotlib.figure.Figure.draw
+    monkeypatch.setattr(matplotlib.figure.Figure, "draw",
+                        lambda fig, renderer: renders.append(1) or original(fig, renderer))
+    fast = [_png_pixels(png) for png in plot.frame_pngs(anim)]
+    assert len(renders) == 1 and len(fast) == len(anim.iterations)
+    monkeypatch.setattr(matplotlib.figure.Figure, "draw", original)
+    fig = anim._fig
+    for j, frame in enumerate(fast):
+        full = _png_pixels(plot.still_png(anim, j))
+        assert full.shape == frame.shape
+        renderer = fig.canvas.get_renderer()
+        inside = np.zeros(full.shape[:2], bool)
+        for artist in anim.draw_frame(j):
+            box = artist.get_window_extent(renderer)
+            top = full.shape[0] - int(np.ceil(box.y1)) - 2
+            inside[max(top, 0): full.shape[0] - int(box.y0) + 2, max(int(box.x0) - 2, 0): int(np.ceil(box.x1)) + 2] = True
+        differs = np.any(full != frame, axis=-1)
+        assert not np.any(differs & ~inside), f"frame {j} differs outside its moving artists"
+        assert differs.mean() < 0.002, f"frame {j}: {differs.mean():.4f} of the pixels differ"
+
+
+def test_to_html_embeds_the_blitted_frames_and_plays_like_to_jshtml():
+    anim = _animation("solve")
+    html = plot.to_html(anim, default_mode="once")
+    reference = anim.to_jshtml(default_mode="once")
+    assert html.count("data:image/png;base64") == len(anim.iterations)
+    import re
+
+    def page(h):  # the HTML and script around the frames, ids made equal
+        return re.sub(r"[0-9a-f]{32}", "ID", re.sub(r"data:image/png;base64,[A-Za-z0-9+/=\\\n]+", "PNG", h))
+
+    assert page(html) == page(reference)
+    assert plot.embed_size(anim) == len(html.encode())
