@@ -17,3 +17,27 @@ def pinv_step(J, e, rcond=DEFAULT_RCOND):
     keep = sigma >= rcond * sigma[0]
     inv_sigma = jnp.where(keep & (sigma > 0), 1.0 / jnp.where(keep & (sigma > 0), sigma, 1.0), 0.0)
     return Vt.T @ (inv_sigma * (U.T @ e))
+
+
+@jax.jit
+def pinv_two_rows(J, e, rcond=DEFAULT_RCOND):
+    """pinv_step for a 2 x n Jacobian (planar position targets) without an SVD call.
+
+    One Jacobi rotation R makes the rows of U = R J orthogonal: then J = R^T U, the singular
+    values are the row lengths |u_i| and J^+ e = sum_i (R e)_i u_i / |u_i|^2, with the same
+    cut-off as pinv_step. A batched SVD of tiny matrices costs far more than this arithmetic.
+    """
+    J, e = jnp.asarray(J), jnp.asarray(e)
+    G = J @ J.T  # products as matrix products: solve and solve_batch then agree to the bit
+    a, b, c = G[0, 0], G[1, 1], G[0, 1]
+    zeta = (b - a) / (2.0 * jnp.where(c == 0, 1.0, c))
+    t = jnp.where(zeta >= 0, 1.0, -1.0) / (jnp.abs(zeta) + jnp.sqrt(1.0 + zeta * zeta))
+    t = jnp.where(c == 0, 0.0, t)  # rows already orthogonal
+    cos = 1.0 / jnp.sqrt(1.0 + t * t)
+    sin = cos * t
+    R = jnp.stack([jnp.stack([cos, -sin]), jnp.stack([sin, cos])])
+    U = R @ J
+    sigma = jnp.sqrt(jnp.diagonal(U @ U.T))
+    keep = (sigma >= rcond * jnp.max(sigma)) & (sigma > 0)
+    weight = jnp.where(keep, (R @ e) / jnp.where(keep, sigma * sigma, 1.0), 0.0)
+    return U.T @ weight

@@ -28,7 +28,7 @@ from .jt import jt_step
 from .levels import DEFAULT_REST_GAIN, with_priorities
 from .joint_limits import with_limits
 from .limits import cap_step, clamp_error
-from .pinv import DEFAULT_RCOND, pinv_step
+from .pinv import DEFAULT_RCOND, pinv_step, pinv_two_rows
 from .tasks import task_for
 from . import stop_rules
 from . import xla
@@ -73,6 +73,8 @@ def _jt(J, e, s):
 
 
 def _pinv(J, e, s):
+    if J.shape[0] == 2:  # planar position targets: the closed form, no SVD call
+        return pinv_two_rows(J, e, s.rcond)
     return pinv_step(J, e, s.rcond)
 
 

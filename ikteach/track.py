@@ -46,8 +46,12 @@ def clamp_blocks(e, block, d_max):
     return (parts * scale).reshape(-1)
 
 
+CHUNK = 128  # time steps per compiled scan: paths of any length reuse one program
+
+
 @partial(xla.jit, static_argnames=("method", "task"))
 def _track(method, task, arm, targets, theta0, settings, d_max):
+    """CHUNK (or fewer) steps; returns the last theta and every step's theta and error."""
     block = getattr(task, "block_size", None)
 
     def step(theta, target):
@@ -60,8 +64,21 @@ def _track(method, task, arm, targets, theta0, settings, d_max):
         err = jnp.sum(jnp.linalg.norm(e_after.reshape(-1, block or e_after.shape[0]), axis=1))
         return theta, (theta, err)
 
-    _, (thetas, errors) = jax.lax.scan(step, theta0, targets)
-    return jnp.vstack([theta0[None], thetas]), errors
+    return jax.lax.scan(step, theta0, targets)
+
+
+def _track_chunks(method, task, arm, targets, theta0, settings, d_max):
+    """Run the path CHUNK steps at a time, the last chunk padded by repeating the last target
+    (its extra steps are dropped), so every path length runs the same compiled program."""
+    steps = targets.shape[0]
+    padded = np.concatenate([targets, np.repeat(targets[-1:], -steps % CHUNK, axis=0)])
+    theta, thetas, errors = jnp.asarray(theta0), [np.asarray(theta0)[None]], []
+    for first in range(0, padded.shape[0], CHUNK):
+        theta, (chunk_thetas, chunk_errors) = _track(method, task, arm, padded[first: first + CHUNK],
+                                                     theta, settings, d_max)
+        thetas.append(np.asarray(chunk_thetas))
+        errors.append(np.asarray(chunk_errors))
+    return np.concatenate(thetas)[: steps + 1], np.concatenate(errors)[:steps]
 
 
 def track(arm, targets, theta0=None, method="dls", damping=DEFAULT_DAMPING, rcond=DEFAULT_RCOND,
@@ -85,10 +102,11 @@ def track(arm, targets, theta0=None, method="dls", damping=DEFAULT_DAMPING, rcon
         rcond=as_number(rcond, "rcond", minimum=0), clamp=np.inf,
         max_step=np.inf if max_step is None else as_number(max_step, "max_step", minimum=0, strict=True),
         stall_tol=0.0, gamma_max=as_number(gamma_max, "gamma_max", minimum=0, strict=True))
-    method, settings, theta0 = with_extras(method, task, arm, jnp.asarray(targets), jnp.asarray(theta0),
+    first = jnp.asarray(targets[:1])  # with_extras looks at the first target only: one shape
+    method, settings, theta0 = with_extras(method, task, arm, first, jnp.asarray(theta0),
                                            settings, levels, rest_pose, rest_gain, joint_limits,
                                            limit_mode, batch=True)
     d_max = np.inf if clamp is None else as_number(clamp, "clamp", minimum=0, strict=True)
-    thetas, errors = _track(method, task, arm, jnp.asarray(targets), jnp.asarray(theta0), settings,
-                            jnp.asarray(d_max))
-    return TrackResult(np.asarray(thetas), np.asarray(errors))
+    thetas, errors = _track_chunks(method, task, arm, np.asarray(targets), theta0, settings,
+                                   jnp.asarray(d_max))
+    return TrackResult(thetas, errors)

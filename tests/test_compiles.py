@@ -72,3 +72,19 @@ def test_eager_solves_with_a_python_step_compile_nothing_new(stop_rule):
     for target in ([2.0, 1.0], [4.0, 0.5], [1.0, -1.5]):  # reachable and out of reach
         ik.solve(ARM, target, START, method=_numpy_stop_step, max_iter=50, stop_rule=stop_rule)
     assert len(COMPILES) == before, COMPILES[before:]
+
+
+def test_paths_of_any_length_track_with_one_program():
+    """track runs paths CHUNK steps at a time: a new length compiles nothing, and a path's
+    first steps are the same whatever follows them (across chunk boundaries too)."""
+    from ikteach.track import CHUNK
+
+    path = np.stack([np.linspace(1.0, 2.8, 2 * CHUNK + 9), np.linspace(0.5, 1.2, 2 * CHUNK + 9)], 1)
+    whole = ik.track(ARM, path, START, method="dls", damping=0.2)
+    assert whole.theta.shape == (path.shape[0] + 1, 3) and whole.error.shape == (path.shape[0],)
+    before = len(COMPILES)
+    for steps in (1, 7, CHUNK, CHUNK + 1, 2 * CHUNK + 3):
+        part = ik.track(ARM, path[:steps], START, method="dls", damping=0.2)
+        np.testing.assert_array_equal(part.theta, whole.theta[: steps + 1])
+        np.testing.assert_array_equal(part.error, whole.error[:steps])
+    assert len(COMPILES) == before, COMPILES[before:]

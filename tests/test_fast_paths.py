@@ -1,5 +1,5 @@
 """The solver's specialised arithmetic equals the general path it replaces: the closed-form
-small solve of DLS, e and J from one walk of the chain, and refilling slots every few steps."""
+small solve of DLS, the two-row pseudoinverse, e and J from one walk of the chain, and refilling slots every few steps."""
 import jax
 import numpy as np
 import pytest
@@ -80,3 +80,39 @@ def test_refilling_every_few_steps_changes_no_result(monkeypatch, steps):
     np.testing.assert_array_equal(other.theta, default.theta)
     np.testing.assert_array_equal(other.iterations, default.iterations)
     np.testing.assert_array_equal(other.status, default.status)
+
+
+def _two_row_jacobians():
+    """Random 2 x n Jacobians: general, nearly rank one, badly scaled, and exactly degenerate."""
+    rng = np.random.default_rng(5)
+    for n in (1, 2, 3, 5, 10):
+        for k in range(40):
+            J = rng.normal(size=(2, n))
+            if k % 3 == 1:
+                J[1] = rng.uniform(-2, 2) * J[0] + 10.0 ** rng.uniform(-12, -3) * rng.normal(size=n)
+            if k % 3 == 2:
+                J *= 10.0 ** rng.uniform(-5, 5)
+            yield J, rng.normal(size=2)
+    for J in ([[0, 0, 0], [0, 0, 0]], [[1, 0, 0], [0, 0, 0]], [[0, 0, 0], [0, 2, 0]],
+              [[1, 1, 0], [1, 1, 0]], [[1, 0, 0], [0, 1, 0]], [[3, 4, 0], [0, 0, 1e-9]]):
+        yield np.array(J, float), np.array([1.0, -2.0])
+
+
+def test_the_two_row_pseudoinverse_equals_the_svd_one():
+    from ikteach.pinv import pinv_two_rows
+
+    for J, e in _two_row_jacobians():
+        want = np.asarray(ik.pinv_step(J, e))
+        got = np.asarray(pinv_two_rows(J, e))
+        np.testing.assert_allclose(got, want, rtol=1e-8, atol=1e-12 * np.abs(want).max(initial=1e-300))
+        np.testing.assert_allclose(got, np.linalg.pinv(J, rcond=1e-6) @ e, rtol=1e-7,
+                                   atol=1e-12 * np.abs(want).max(initial=1e-300))
+
+
+@pytest.mark.parametrize("rcond", [1e-6, 0.5])
+def test_the_two_row_pseudoinverse_drops_the_same_singular_values(rcond):
+    from ikteach.pinv import pinv_two_rows
+
+    J = np.array([[1.0, 0.0, 0.0], [0.0, 0.4, 0.0]])  # sigma 1 and 0.4
+    e = np.array([1.0, 1.0])
+    np.testing.assert_allclose(pinv_two_rows(J, e, rcond), ik.pinv_step(J, e, rcond), atol=1e-15)
