@@ -100,28 +100,29 @@ def scene(arm, theta, target=None, trail=None, window_size=WINDOW, ghost=None, p
     p.set_background("white")
     floor = pv.Plane(center=np.asarray(arm.base, dtype=float) - [0, 0, 0.061 * scale],
                      direction=(0, 0, 1), i_size=2.4 * scale, j_size=2.4 * scale)
-    p.add_mesh(floor, color="#f2f2f2", ambient=0.6, diffuse=0.4)
+    p.add_mesh(floor, color="#f2f2f2", ambient=0.6, diffuse=0.4, render=False)
     if ghost is not None:
         for mesh, colour in arm_meshes(arm, ghost, scale):
-            p.add_mesh(mesh, color=colour, opacity=0.25)
+            p.add_mesh(mesh, color=colour, opacity=0.25, render=False)
     for mesh, colour in arm_meshes(arm, theta, scale):
-        p.add_mesh(mesh, color=colour, smooth_shading=True)
+        p.add_mesh(mesh, color=colour, smooth_shading=True, render=False)
     _, _, T = frames(arm, theta)
     for mesh, colour in triad(T, 0.2 * scale):
-        p.add_mesh(mesh, color=colour)
+        p.add_mesh(mesh, color=colour, render=False)
     if target is not None:
         target = np.asarray(target, dtype=float)
         if target.shape == (4, 4):
             for mesh, colour in triad(target, 0.28 * scale):
-                p.add_mesh(mesh, color=colour, opacity=0.5)
+                p.add_mesh(mesh, color=colour, opacity=0.5, render=False)
             centre = target[:3, 3]
         else:
             centre = np.append(target, 0.0)[:3] if target.shape == (2,) else target
-        p.add_mesh(pv.Sphere(center=centre, radius=0.025 * scale), color=COLORS["target"], opacity=0.6)
+        p.add_mesh(pv.Sphere(center=centre, radius=0.025 * scale), color=COLORS["target"], opacity=0.6,
+                   render=False)
     if trail is not None:
         mesh = trail_mesh(trail, scale)
         if mesh is not None:
-            p.add_mesh(mesh, color=COLORS["trail"])
+            p.add_mesh(mesh, color=COLORS["trail"], render=False)
     p.camera_position = _camera(arm, scale)
     p.camera.view_angle = 24.0
     p._ikteach_alt = describe(arm, theta, target=target, trail=trail, ghost=ghost)

@@ -52,11 +52,19 @@ def test_arm_meshes_sit_on_the_joints():
     np.testing.assert_allclose(T[:3, 3], np.asarray(ik.fk(arm, theta)), atol=1e-12)
 
 
-def test_solve_gif_writes_frames(tmp_path):
+def test_solve_gif_writes_frames(tmp_path, monkeypatch):
+    import pyvista as pv
+
     arm = ik.ur5()
     target = np.asarray(ik.fk_pose(arm, SCENE_THETA + 0.2))
     res = ik.solve(arm, target, SCENE_THETA, tol=1e-6, damping=0.05, max_iter=100)
+    renders = []
+    original = pv.Plotter.render
+    monkeypatch.setattr(pv.Plotter, "render", lambda self: renders.append(1) or original(self))
     path = scene.solve_gif(arm, res.trace.theta, tmp_path / "solve.gif", target=target, frames_max=5)
+    # one render per frame: adding a mesh to a plotter that has rendered once re-renders it
+    # unless told not to, about 25 extra renders per frame
+    assert len(renders) <= 2 * 5
     from PIL import Image
 
     with Image.open(path) as gif:
