@@ -32,25 +32,28 @@ def _toward(a, b, d):
 def fabrik_forward(points, lengths, target):
     """Forward reaching: end effector onto the target, then each joint back along its link."""
     n = lengths.shape[0]
-    points = points.at[n].set(target)
-    for i in range(n - 1, -1, -1):
-        points = points.at[i].set(_toward(points[i + 1], points[i], lengths[i]))
-    return points
+
+    def reach_back(k, points):  # i = n-1, ..., 0
+        i = n - 1 - k
+        return points.at[i].set(_toward(points[i + 1], points[i], lengths[i]))
+
+    return jax.lax.fori_loop(0, n, reach_back, points.at[n].set(target))
 
 
 def fabrik_backward(points, lengths, base):
     """Backward reaching: the root back onto the base, then each joint out along its link."""
-    points = points.at[0].set(base)
-    for i in range(lengths.shape[0]):
-        points = points.at[i + 1].set(_toward(points[i], points[i + 1], lengths[i]))
-    return points
+    def reach_out(i, points):  # i = 0, ..., n-1
+        return points.at[i + 1].set(_toward(points[i], points[i + 1], lengths[i]))
+
+    return jax.lax.fori_loop(0, lengths.shape[0], reach_out, points.at[0].set(base))
 
 
 def fabrik_stretch(points, lengths, target):
     """Out of reach: every link points straight at the target, p_{i+1} = p_i + d_i unit(t - p_i)."""
-    for i in range(lengths.shape[0]):
-        points = points.at[i + 1].set(_toward(points[i], target, lengths[i]))
-    return points
+    def straighten(i, points):
+        return points.at[i + 1].set(_toward(points[i], target, lengths[i]))
+
+    return jax.lax.fori_loop(0, lengths.shape[0], straighten, points)
 
 
 @jax.jit
