@@ -12,9 +12,11 @@ import argparse
 import os
 import time
 
+import jax
 import numpy as np
 
 import ikteach as ik
+from ikteach import batch as batch_module
 from ikteach.solve import STALL_FRACTION
 
 import native  # benchmarks/native: the scalar C loop
@@ -80,10 +82,17 @@ def main():
     targets = np.stack([X.ravel(), Y.ravel()], axis=1)
     kw = dict(method="dls", tol=TOL, max_iter=MAX_ITER, damping=DAMPING)
 
+    split = batch_module.split_devices(len(targets))
     t0 = time.perf_counter()
     ik.solve_batch(arm, targets, THETA0, **kw)
     compile_and_run = time.perf_counter() - t0
+    if split:
+        split_time, split_batch = best_of(args.repeats,
+                                          lambda: ik.solve_batch(arm, targets, THETA0, **kw))
+    batch_module.SPLIT_FROM, keep = 10**12, batch_module.SPLIT_FROM  # one device, one core
+    ik.solve_batch(arm, targets, THETA0, **kw)
     jax_time, batch = best_of(args.repeats, lambda: ik.solve_batch(arm, targets, THETA0, **kw))
+    batch_module.SPLIT_FROM = keep
 
     lib = native.build()
     if lib is not None:
@@ -105,8 +114,11 @@ def main():
     print(f"| {'implementation':<40} | {'targets':>9} | {'iterations':>12} | {'seconds':>8} | "
           f"{'targets/s':>11} |")
     print(f"|{'-' * 42}|{'-' * 11}|{'-' * 14}|{'-' * 10}|{'-' * 13}|")
-    jax_rate = table_row("ik.solve_batch (jit+vmap), compiled", len(targets), jax_time,
+    jax_rate = table_row("ik.solve_batch (jit+vmap), 1 device", len(targets), jax_time,
                          int(batch.iterations.sum()))
+    if split:
+        split_rate = table_row(f"ik.solve_batch split over {len(split)} CPU devices", len(targets),
+                               split_time, int(split_batch.iterations.sum()))
     if lib is not None:
         c_rate = table_row("scalar C loop (gcc -O3, ctypes), 1 core", len(targets), c_time, c_total)
     if len(subset):  # --numpy-subset 0 leaves the (slow) numpy row out
@@ -114,7 +126,11 @@ def main():
                             sum(it for _, it in ref))
     print()
     print(f"first solve_batch call incl. compile: {compile_and_run:.2f} s; best of {args.repeats} "
-          f"runs after")
+          f"runs after; devices {[str(d) for d in jax.devices()]}")
+    if split:
+        same = all(np.array_equal(getattr(batch, f), getattr(split_batch, f))
+                   for f in ("theta", "status", "iterations", "error"))
+        print(f"split and one-device results identical to the bit: {same}")
     if len(subset):
         print(f"solve_batch vs numpy: {jax_rate / np_rate:.0f}x faster")
     if lib is not None:
@@ -122,6 +138,9 @@ def main():
         same = np.mean((names == batch.status) & (c_iters == batch.iterations))
         print(f"solve_batch vs scalar C: {c_rate / jax_rate:.2f}x slower "
               f"(goal <= 3x); same status and iteration count for {same:.2%} of the targets")
+        if split:
+            print(f"solve_batch split over {len(split)} devices vs scalar C on 1 core: "
+                  f"{split_rate / c_rate:.2f}x as fast (stretch goal > 1)")
     else:
         print("scalar C row skipped: no C compiler (gcc or cc) found")
     if len(subset):

@@ -8,7 +8,10 @@ import importlib
 
 import jax
 
+from . import host_devices
+
 jax.config.update("jax_enable_x64", True)
+host_devices.request(jax)  # one CPU device per core, for solve_batch (before JAX starts)
 
 from .chain import Chain, planar_chain, serial_chain, reach  # noqa: E402
 from .kinematics import fk, joint_positions, joint_frames, rotation_about  # noqa: E402

@@ -5,8 +5,13 @@ lane busy until the slowest target is done, so instead a fixed number of slots r
 by side and a slot whose target has finished takes the next target from the queue:
 the work is the sum of the iterations, not the batch size times the largest count.
 Slots are refilled every STEPS_PER_REFILL steps; a slot that finishes in between idles.
+
+With several devices (one CPU device per core, ikteach/host_devices.py) a large batch is
+split into equal shares, one per device, each running its own queue: every core works, and
+each target still gets the same arithmetic (the same iterates to the last bit).
 """
 import dataclasses
+import functools
 from functools import partial
 
 import jax
@@ -20,7 +25,8 @@ from .solve import (DEFAULT_DAMPING, RUNNING, STATUSES, advance, check_problem, 
                     resolve_method, status_counts, with_extras)
 from . import xla
 
-SLOTS = 1024  # targets in flight at once
+SLOTS = 1024  # targets in flight at once (per device)
+SPLIT_FROM = 512  # targets per device below which a batch stays on one device
 STEPS_PER_REFILL = 4  # loop steps between refills (a refill costs more than a step)
 
 
@@ -46,8 +52,7 @@ def _select(mask, a, b):
         lambda x, y: jnp.where(mask.reshape(mask.shape + (1,) * (x.ndim - 1)), x, y), a, b)
 
 
-@partial(xla.jit, static_argnames=("method", "task", "max_iter", "slots"))
-def _run_queue(method, task, arm, targets, thetas0, settings, max_iter, slots):
+def _queue(method, task, arm, targets, thetas0, settings, max_iter, slots):
     """Solve every target; `slots` of them in flight, refilled from the queue as they finish."""
     count = targets.shape[0]
     step = jax.vmap(lambda t, s: advance(method, task, arm, t, settings, max_iter, s))
@@ -77,6 +82,67 @@ def _run_queue(method, task, arm, targets, thetas0, settings, max_iter, slots):
     return jax.lax.while_loop(lambda c: jnp.any(c[1].status == RUNNING), body, carry)[2]
 
 
+_run_queue = partial(xla.jit, static_argnames=("method", "task", "max_iter", "slots"))(_queue)
+
+
+def _shard_map():
+    """jax.shard_map and the keyword that turns its replication check off (older jax: the
+    experimental one); None when this jax has neither."""
+    if hasattr(jax, "shard_map"):
+        return jax.shard_map, {"check_vma": False}
+    try:
+        from jax.experimental.shard_map import shard_map
+    except ImportError:
+        return None
+    return shard_map, {"check_rep": False}
+
+
+@functools.lru_cache(maxsize=None)
+def _mesh(devices):
+    return jax.sharding.Mesh(np.array(devices), ("targets",))
+
+
+@partial(xla.jit, static_argnames=("method", "task", "max_iter", "slots", "mesh"))
+def _run_split(method, task, arm, targets, thetas0, settings, max_iter, slots, mesh):
+    """_queue on every device of the mesh, each on its share of the rows of targets."""
+    shard_map, check_off = _shard_map()
+    P = jax.sharding.PartitionSpec
+
+    def share(arm, settings, targets, thetas0):
+        return _queue(method, task, arm, targets, thetas0, settings, max_iter, slots)
+
+    return shard_map(share, mesh=mesh, in_specs=(P(), P(), P("targets"), P("targets")),
+                     out_specs=P("targets"), **check_off)(arm, settings, targets, thetas0)
+
+
+def split_devices(count):
+    """The devices a batch of `count` targets is split over: all local devices when there are
+    several and every share gets SPLIT_FROM targets or more; else None (one device)."""
+    devices = jax.local_devices()
+    if len(devices) < 2 or count < SPLIT_FROM * len(devices) or _shard_map() is None:
+        return None
+    return tuple(devices)
+
+
+def _run(method, task, arm, targets, thetas0, settings, max_iter):
+    """_run_queue on one device, or _run_split over all of them: device k takes rows k, k + D,
+    k + 2D, ... (neighbouring targets cost alike, so the shares take about as long), the rows
+    padded to a multiple of D with copies of the last one, dropped again."""
+    count = targets.shape[0]
+    devices = split_devices(count)
+    if devices is None:
+        return _run_queue(method, task, arm, targets, thetas0, settings, max_iter,
+                          min(SLOTS, count))
+    d = len(devices)
+    share = -(-count // d)
+    rows = np.minimum(np.arange(share * d).reshape(share, d).T.ravel(), count - 1)
+    state = _run_split(method, task, arm, np.asarray(targets)[rows], np.asarray(thetas0)[rows],
+                       settings, max_iter, min(SLOTS, share), _mesh(devices))
+    back = np.arange(count)
+    back = (back % d) * share + back // d  # where row r went
+    return jax.tree_util.tree_map(lambda x: np.asarray(x)[back], state)
+
+
 def solve_batch(arm, targets, theta0, method="dls", tol=1e-3, max_iter=1000,
                 damping=DEFAULT_DAMPING, rcond=DEFAULT_RCOND, clamp=None, max_step=None,
                 stall_tol=None, gamma_max=GAMMA_MAX, weights=None, stop_rule="joint_steps",
@@ -98,8 +164,7 @@ def solve_batch(arm, targets, theta0, method="dls", tol=1e-3, max_iter=1000,
                                            rest_pose, rest_gain, joint_limits, limit_mode, batch=True)
     if theta0.ndim == 1:
         theta0 = jnp.broadcast_to(theta0, (targets.shape[0], theta0.shape[0]))
-    state = _run_queue(method, task, arm, targets, theta0, settings, max_iter,
-                       min(SLOTS, targets.shape[0]))
+    state = _run(method, task, arm, targets, theta0, settings, max_iter)
     return BatchResult(
         theta=np.asarray(state.theta),
         status=np.asarray(STATUSES, dtype=object)[np.asarray(state.status)],
