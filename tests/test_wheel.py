@@ -39,6 +39,17 @@ res = ik.solve(arm, np.array([2.0, 1.0]), np.zeros(3), method="dls", damping=0.5
 assert res.status == "converged", res.status
 print("solve:", res.status, res.iterations)
 
+import jax
+from ikteach import batch, host_devices
+grid = np.stack(np.meshgrid(np.linspace(-3.2, 3.2, 48), np.linspace(-3.2, 3.2, 48)), -1).reshape(-1, 2)
+batch.SPLIT_FROM = 64  # split even this small grid over the devices, then compare with one
+split = ik.solve_batch(arm, grid, np.full(3, 0.3))
+batch.SPLIT_FROM = 10**9
+whole = ik.solve_batch(arm, grid, np.full(3, 0.3))
+assert len(jax.devices()) == host_devices.wanted(), (jax.devices(), host_devices.wanted())
+assert np.array_equal(split.theta, whole.theta) and np.array_equal(split.iterations, whole.iterations)
+print("batch:", len(jax.devices()), "devices, split = whole")
+
 import matplotlib
 matplotlib.use("Agg")
 from matplotlib.figure import Figure
@@ -131,7 +142,7 @@ def test_wheel_in_a_clean_venv_solves_plots_and_renders(dist, tmp_path):
     work.mkdir()
     (work / "smoke.py").write_text(SMOKE)
     out = _run(python, "smoke.py", str(ROOT), "--scene", "--probe", PROBE, cwd=work).stdout
-    assert "solve: converged" in out and "plot: arm.png" in out
+    assert "solve: converged" in out and "split = whole" in out and "plot: arm.png" in out
     assert "scene: (" in out and "data: probe data file" in out
     frozen = _uv("pip", "list", "--python", str(python)).stdout
     for extra in ("jupyterlab", "nbclient", "pytest"):
@@ -162,4 +173,4 @@ def test_wheel_on_a_colab_like_kernel_keeps_colabs_versions(dist, tmp_path):
     work.mkdir()
     (work / "smoke.py").write_text(SMOKE)
     out = _run(python, "smoke.py", str(ROOT), "--demo", cwd=work).stdout
-    assert "solve: converged" in out and "demo: 7.7.1" in out
+    assert "solve: converged" in out and "split = whole" in out and "demo: 7.7.1" in out
