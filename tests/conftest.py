@@ -15,3 +15,28 @@ collect_ignore_glob = ["submissions/*"]
 from ikteach.notebook import compilation_cache  # noqa: E402
 
 compilation_cache()
+
+
+def _retry_nbval_kernel_start(attempts=3):
+    """nbval starts one kernel per notebook; with two xdist workers starting kernels at once,
+    about one start in a hundred dies before answering kernel_info (a port taken between
+    jupyter_client choosing it and the kernel binding it). jupyter_client shuts a failed start
+    down, so start again: a start that fails every time still fails the notebook."""
+    try:
+        from nbval import kernel
+    except ImportError:
+        return
+    start = kernel.RunningKernel.__init__
+
+    def init(self, *args, **kwargs):
+        for attempt in range(attempts):
+            try:
+                return start(self, *args, **kwargs)
+            except RuntimeError:
+                if attempt == attempts - 1:
+                    raise
+
+    kernel.RunningKernel.__init__ = init
+
+
+_retry_nbval_kernel_start()
