@@ -149,17 +149,37 @@ def default_cache_dir():
     return str(pathlib.Path(base) / "ikteach" / "jax")
 
 
+# jaxlib 0.5.x (Colab's in 2026) loads the course's compiled loops from its CPU cache wrongly:
+# every solve comes back "running" after 0 iterations. 0.6.2, 0.7.2, 0.8.3, 0.9.2, 0.10.x load
+# them right (tests/test_wheel.py runs a Colab-like venv twice).
+CACHE_MIN_JAXLIB = (0, 6)
+
+
+def cache_trusted(jaxlib_version=None):
+    """Does this jaxlib load compiled code from its persistent cache correctly?"""
+    if jaxlib_version is None:
+        import jaxlib
+
+        jaxlib_version = getattr(jaxlib, "__version__", None) or jaxlib.version.__version__
+    numbers = []
+    for part in str(jaxlib_version).split(".")[:2]:
+        digits = "".join(c for c in part if c.isdigit())
+        numbers.append(int(digits) if digits else 0)
+    return tuple(numbers) >= CACHE_MIN_JAXLIB
+
+
 def compilation_cache(path=None):
     """Turn on JAX's persistent compilation cache in `path` (default: default_cache_dir()),
     so a notebook's second run loads its compiled solvers from disk instead of compiling.
 
     Every compilation is kept, however quick. Returns the folder, or None when turned off
-    (IKTEACH_JAX_CACHE=off) or the folder cannot be created.
+    (IKTEACH_JAX_CACHE=off), when the folder cannot be created, or with a jaxlib older than
+    CACHE_MIN_JAXLIB, whose CPU cache hands back broken solver loops (it stays off there).
     """
     import jax
 
     path = default_cache_dir() if path is None else str(path)
-    if path is None:
+    if path is None or not cache_trusted():
         return None
     try:
         os.makedirs(path, exist_ok=True)

@@ -2,6 +2,8 @@
 import subprocess
 import sys
 
+import pytest
+
 HEAVY = ("matplotlib", "pyvista", "skimage", "ipywidgets")
 
 
@@ -44,3 +46,11 @@ def test_compilation_cache_folder_from_the_environment(tmp_path, monkeypatch):
         assert (tmp_path / "jit").is_dir()
     finally:
         jax.config.update("jax_compilation_cache_dir", old)
+
+
+@pytest.mark.parametrize("version, trusted", [("0.5.1", False), ("0.5.3", False), ("0.4.38", False),
+                                              ("0.6.0", True), ("0.10.2", True), ("1.0.0rc1", True)])
+def test_the_compilation_cache_is_used_only_where_jaxlib_loads_it_right(version, trusted):
+    from ikteach import notebook
+
+    assert notebook.cache_trusted(version) is trusted
