@@ -150,7 +150,7 @@ def default_cache_dir():
 
 
 # jaxlib 0.5.x (Colab's in 2026) loads the course's compiled loops from its CPU cache wrongly:
-# every solve comes back "running" after 0 iterations. 0.6.2, 0.7.2, 0.8.3, 0.9.2, 0.10.x load
+# every solve comes back "running" after 0 iterations. 0.6.2, 0.7.2, 0.8.3, 0.9.2, 0.10, 0.12 load
 # them right (tests/test_wheel.py runs a Colab-like venv twice).
 CACHE_MIN_JAXLIB = (0, 6)
 
