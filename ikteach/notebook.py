@@ -178,6 +178,8 @@ def compilation_cache(path=None):
     """
     import jax
 
+    from . import program_store
+
     path = default_cache_dir() if path is None else str(path)
     if path is None or not cache_trusted():
         return None
@@ -187,4 +189,5 @@ def compilation_cache(path=None):
         return None
     jax.config.update("jax_compilation_cache_dir", path)
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
+    program_store.open_store(path)  # whole programs too: no tracing either (program_store.py)
     return path

@@ -17,6 +17,8 @@ import os
 
 import jax
 
+from . import program_store
+
 FAST_COMPILE = {"xla_cpu_use_fusion_emitters": False}
 OPTIONS_ENV = "IKTEACH_XLA_OPTIONS"
 
@@ -41,9 +43,13 @@ COMPILER_OPTIONS = _chosen()
 
 def jit(fun=None, **kwargs):
     """jax.jit(fun, **kwargs) with COMPILER_OPTIONS; as a decorator, with or without arguments
-    (`@jit`, `@partial(jit, static_argnames=...)`)."""
+    (`@jit`, `@partial(jit, static_argnames=...)`). Its executables are also kept whole in the
+    program store when compilation_cache() opened one (ikteach/program_store.py)."""
     if fun is None:
         return functools.partial(jit, **kwargs)
     if COMPILER_OPTIONS:
         kwargs.setdefault("compiler_options", COMPILER_OPTIONS)
-    return jax.jit(fun, **kwargs)
+    jitted = jax.jit(fun, **kwargs)
+    if "static_argnums" in kwargs:
+        return jitted
+    return program_store.StoredProgram(fun, jitted, kwargs.get("static_argnames", ()))

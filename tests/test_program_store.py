@@ -1,0 +1,171 @@
+"""ikteach.program_store: a program loaded whole from disk computes exactly what jax.jit does,
+and the store steps aside wherever its key could be wrong."""
+import json
+import math
+import os
+import subprocess
+import sys
+import warnings
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import ikteach as ik
+from ikteach import program_store, xla
+
+# Each kind of stored program once: solve (no LAPACK; a pose target's DLS solves with LAPACK;
+# FABRIK's loops), solve_batch and track. Floats as hex: equal means equal to the last bit.
+SCRIPT = """
+import json, numpy as np, ikteach as ik
+from ikteach import program_store
+ik.notebook.compilation_cache()
+planar, ur5 = ik.planar_chain([1.0, 0.7, 0.4]), ik.ur5()
+pose = np.asarray(ik.fk_pose(ur5, np.full(6, 0.4)))
+hexes = lambda x: [float(v).hex() for v in np.ravel(x)]
+out = {}
+for name, (arm, target, method) in {"jt": (planar, [1.2, 0.9], "jt"),
+                                    "fabrik": (planar, [1.2, 0.9], "fabrik"),
+                                    "dls pose": (ur5, pose, "dls")}.items():
+    r = ik.solve(arm, target, np.full(arm.n_joints, 0.2), method=method, max_iter=200)
+    out[name] = [r.status, r.iterations, hexes(r.theta), hexes(r.trace.error)]
+g = np.linspace(-2.3, 2.3, 12)
+b = ik.solve_batch(planar, np.stack(np.meshgrid(g, g), -1).reshape(-1, 2), [0.3, 0.2, 0.1])
+out["batch"] = [b.status.tolist(), b.iterations.tolist(), hexes(b.theta)]
+t = ik.track(planar, np.linspace([1.5, 0.2], [0.3, 1.4], 30), [0.3, 0.2, 0.1])
+out["track"] = hexes(t.theta)
+out["counts"] = dict(program_store.counts)
+print(json.dumps(out))
+"""
+
+
+def run_script(cache, store="on"):
+    env = dict(os.environ, IKTEACH_JAX_CACHE=str(cache), IKTEACH_PROGRAM_STORE=store)
+    done = subprocess.run([sys.executable, "-c", SCRIPT], capture_output=True, text=True,
+                          env=env, timeout=300)
+    assert done.returncode == 0, done.stderr[-3000:]
+    out = json.loads(done.stdout.splitlines()[-1])
+    return out.pop("counts"), out
+
+
+def test_a_second_process_loads_every_program_and_gets_the_same_bits(tmp_path):
+    plain_counts, plain = run_script(tmp_path / "plain", store="off")
+    first_counts, first = run_script(tmp_path / "store")
+    second_counts, second = run_script(tmp_path / "store")
+    assert plain_counts == {}
+    assert first_counts.get("compiled", 0) >= 5 and first_counts.get("loaded", 0) == 0
+    assert second_counts == {"loaded": first_counts["compiled"]}  # no tracing, no compiling
+    assert first == plain and second == plain
+    assert plain["dls pose"][0] == "converged" and plain["jt"][0] == "converged"
+
+
+@pytest.fixture
+def store(tmp_path, monkeypatch):
+    """A fresh store for this test only."""
+    monkeypatch.setattr(program_store, "_root", None)
+    monkeypatch.setattr(program_store, "_broken", False)
+    monkeypatch.setattr(program_store, "counts", program_store.collections.Counter())
+    assert program_store.open_store(tmp_path) is not None
+    return program_store
+
+
+def square_sum(x, scale, power):
+    return scale * jnp.sum(x ** power)
+
+
+def test_programs_are_kept_by_shape_and_static_value(store):
+    program = xla.jit(square_sum, static_argnames=("power",))
+    assert float(program(jnp.arange(3.0), 2.0, power=2)) == 10.0
+    assert float(program(jnp.arange(3.0), 3.0, power=2)) == 15.0  # new value: same program
+    assert float(program(jnp.arange(4.0), 1.0, power=2)) == 14.0  # new shape
+    assert float(program(jnp.arange(3.0), 1.0, power=3)) == 9.0  # new static value
+    assert store.counts == {"compiled": 3}
+    assert len(list(store._root.glob("*.bin"))) == 3
+    program._loaded.clear()  # as in a new process
+    assert float(program(jnp.arange(3.0), 1.0, power=3)) == 9.0
+    assert store.counts["loaded"] == 1
+
+
+def test_a_damaged_file_is_compiled_again(store):
+    program = xla.jit(square_sum, static_argnames=("power",))
+    program(jnp.arange(3.0), 2.0, power=2)
+    (path,) = store._root.glob("*.bin")
+    path.write_bytes(b"not a program")
+    program._loaded.clear()
+    assert float(program(jnp.arange(3.0), 2.0, power=2)) == 10.0
+    assert store.counts == {"compiled": 2}
+    assert path.read_bytes() != b"not a program"
+
+
+def test_a_program_that_fails_to_run_falls_back_to_jit(store):
+    program = xla.jit(square_sum, static_argnames=("power",))
+    program(jnp.arange(3.0), 2.0, power=2)
+    (path,) = store._root.glob("*.bin")
+
+    def broken(*args):
+        raise RuntimeError("a bad executable")
+
+    for loaded in program._loaded.values():
+        loaded.compiled = broken
+    with pytest.warns(RuntimeWarning, match="failed to run"):
+        assert float(program(jnp.arange(3.0), 2.0, power=2)) == 10.0
+    assert not path.exists() and store._broken
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert float(program(jnp.arange(3.0), 2.0, power=2)) == 10.0  # plain jit, quietly
+
+
+def test_a_students_step_function_is_never_stored(store):
+    arm = ik.planar_chain([1.0, 1.0])
+    res = ik.solve(arm, [1.0, 1.0], [0.3, 0.3], method=lambda J, e: 0.5 * J.T @ e)
+    assert res.converged
+    assert store.counts == {"plain": 1}
+
+
+def test_a_patched_module_turns_the_store_off(store, monkeypatch):
+    arm = ik.planar_chain([1.0, 1.0])
+    assert program_store.patched_modules() == []
+    monkeypatch.setattr(ik.jt, "jt_step", lambda J, e: J.T @ e)  # a notebook's patch
+    assert program_store.patched_modules() == ["ikteach.jt"]
+    ik.solve(arm, [1.0, 1.0], [0.3, 0.3], method="jt")
+    assert store.counts == {"plain": 1}
+
+
+def test_a_committed_array_goes_to_plain_jit(store):
+    program = xla.jit(square_sum, static_argnames=("power",))
+    x = jax.device_put(jnp.arange(3.0), jax.devices()[0])
+    assert float(program(x, 2.0, power=2)) == 10.0
+    assert store.counts == {"plain": 1}
+
+
+def outer_scale():
+    return 2.0
+
+
+@pytest.mark.parametrize("value, stable", [
+    (1, True), (1.5, True), ("dls", True), (None, True), ((1, "a", 2.5), True),
+    ({1: [2, 3]}, True), (np.arange(3.0), True), (np.float64(0.5), True), (np.add, True),
+    (ik.solve, True), (ik.METHODS["dls"], True), (math.hypot, True),
+    (ik.planar_chain([1.0]), True),  # an ikteach dataclass: its fields, arrays by content
+    (lambda x: x, False),  # no name
+    (outer_scale, False),  # a name, but not in ikteach: its body may differ in the next process
+    (object(), False), (jnp.linalg.norm, False),  # no stable text: plain jit decides
+])
+def test_describe_names_only_values_it_can_name_in_every_process(value, stable):
+    assert (program_store.describe(value) is not None) == stable
+
+
+def test_describe_tells_values_apart():
+    d = program_store.describe
+    assert d(np.arange(3.0)) == d(np.arange(3.0)) != d(np.arange(3.0) + [0, 0, 1e-12])
+    assert len({d(1), d(1.0), d(True), d("1")}) == 4
+    assert d((1, 2)) != d([1, 2])
+    assert d(ik.METHODS["jt"]) != d(ik.METHODS["dls"])
+    assert d({"a": 1, "b": 2}) == d({"b": 2, "a": 1})
+
+
+def test_every_ikteach_module_is_unpatched_after_import():
+    for name in ("scene", "workspace", "demo", "plot", "character_scene", "grade"):
+        getattr(ik, name, None)
+    assert program_store.patched_modules() == []
