@@ -54,14 +54,17 @@ def animate_clips(rig, clips, titles, root, view="side", every=3, interval=100, 
     """A FuncAnimation of clips (each (F, m, 3) world points of rig.points), one column each,
     every `every`-th frame, the camera following root (F, 3). With contact (F, k) and `feet`
     (indices into rig.points) a planted foot gets a red dot; footprints (n, 3) are drawn as
-    grey crosses; close_up adds a row that looks at the feet from near the ground."""
-    import matplotlib.pyplot as plt
-    from matplotlib.animation import FuncAnimation
+    grey crosses; close_up adds a row that looks at the feet from near the ground.
 
-    from .plot import fixed_layout
+    The camera follows by moving the drawing, not the axes (x is measured from the root), so
+    the axes stay still and ik.plot.frame_pngs / save_gif draw them once."""
+    import matplotlib.pyplot as plt
+
+    from .plot import _animation
 
     i, j = _plane(view)
     clips, root = [np.asarray(c) for c in clips], np.asarray(root)
+    shown = list(range(0, len(clips[0]), every))
     top = max(c[..., j].max() for c in clips) + 10
     rows = [(110.0, (-5.0, top))] + ([(45.0, (-3.0, 30.0))] if close_up else [])
     fig, axes = plt.subplots(len(rows), len(clips), figsize=(3.6 * len(clips), 2.9 * len(rows)),
@@ -70,31 +73,36 @@ def animate_clips(rig, clips, titles, root, view="side", every=3, interval=100, 
     for r, (half, ylim) in enumerate(rows):
         for c, (clip, title) in enumerate(zip(clips, titles)):
             ax = axes[r, c]
-            ax.set_ylim(*ylim)
             ax.axhline(0, color="0.6", lw=1)
-            if footprints is not None:
-                ax.plot(footprints[:, i], footprints[:, j], "x", color="0.4", ms=6, mew=1.5)
+            prints = ax.plot([], [], "x", color="0.4", ms=6, mew=1.5)[0]
             lines, dots = draw_skeleton(ax, rig, clip[0], view)
             ax.set_aspect("auto")
+            ax.set_xlim(-half, half)
+            ax.set_ylim(*ylim)
+            ax.set_xlabel(f"{'xyz'[i]} from the root (cm)")
             marks = ax.plot([], [], "o", color="C3", ms=6, zorder=5)[0]
             if r == 0:
                 ax.set_title(title, fontsize=10)
-            panels.append((ax, half, lines, dots, marks, clip))
-    fixed_layout(fig)
+            panels.append((lines, dots, marks, prints, clip))
 
-    def frame(f):
+    def frame(k):
+        f = shown[k]
+        shift = np.zeros(3)
+        shift[i] = root[f, i]
         out = []
-        for ax, half, lines, dots, marks, clip in panels:
-            ax.set_xlim(root[f, i] - half, root[f, i] + half)
-            for line, s in zip(lines, stick_segments(rig, clip[f])):
+        for lines, dots, marks, prints, clip in panels:
+            pose = clip[f] - shift
+            for line, s in zip(lines, stick_segments(rig, pose)):
                 line.set_data(s[:, i], s[:, j])
-            dots.set_data(clip[f][:, i], clip[f][:, j])
+            dots.set_data(pose[:, i], pose[:, j])
             if contact is not None:
-                planted = clip[f][[p for p, c in zip(feet, contact[f]) if c]].reshape(-1, 3)
+                planted = pose[[p for p, c in zip(feet, contact[f]) if c]].reshape(-1, 3)
                 marks.set_data(planted[:, i], planted[:, j])
-            out += [*lines, dots, marks]
+            if footprints is not None:
+                prints.set_data(footprints[:, i] - shift[i], footprints[:, j])
+            out += [prints, *lines, dots, marks]
         return out
 
-    anim = FuncAnimation(fig, frame, frames=range(0, len(clips[0]), every), interval=interval)
-    plt.close(fig)
+    anim = _animation(fig, frame, shown, interval)
+    anim.still = 0
     return anim

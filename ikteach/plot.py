@@ -367,6 +367,24 @@ def frame_pngs(anim):
     return pngs
 
 
+def save_gif(anim, path, fps=5, dpi=None):
+    """Write an animation made here as a looping GIF, its frames from frame_pngs (what stays
+    still drawn once), like anim.save(path, writer="pillow", fps=fps, dpi=dpi)."""
+    from PIL import Image
+
+    fig = anim._fig
+    old_dpi = fig.dpi
+    if dpi is not None:
+        fig.set_dpi(dpi)
+    try:
+        frames = [Image.open(io.BytesIO(png)).convert("RGBA") for png in frame_pngs(anim)]
+    finally:
+        fig.set_dpi(old_dpi)
+    frames[0].save(path, save_all=True, append_images=frames[1:], duration=int(1000 / fps),
+                   loop=0)
+    return path
+
+
 def _in_draw_order(fig, artists):
     """The artists in the order a full draw paints them: axes by axes, by zorder, then as added."""
     rank = {}

@@ -22,6 +22,7 @@ machine code), and a program falls back to plain jax.jit whenever the key is not
 A stored program that fails to load or to run is deleted and compiled again with jax.jit.
 """
 import collections
+import contextlib
 import dataclasses
 import functools
 import hashlib
@@ -39,7 +40,7 @@ import warnings
 import jax
 import numpy as np
 
-FORMAT = "ikteach-program-1"
+FORMAT = "ikteach-program-2"
 SUBFOLDER = "programs"
 STORE_ENV = "IKTEACH_PROGRAM_STORE"  # "off": JAX's persistent cache only
 STALE_DAYS = 14  # env folders (other versions, other source) untouched this long are removed
@@ -300,34 +301,39 @@ class StoredProgram:
         except TypeError:  # an unhashable static value: jit reports it
             return self._jitted(*args, **kwargs)
         if program is None:
-            program = self._program(memory_key, tuple(values.values()), static, dynamic,
-                                    treedef, signature)
+            program, out = self._program(memory_key, tuple(values.values()), static, dynamic,
+                                         treedef, signature)
             if program is None:
                 counts["plain"] += 1
                 return self._jitted(*args, **kwargs)
+            if out is not None:
+                return out  # the first run, made while checking the stored copy
         try:
-            return program(*dynamic)
+            # errors of execution surface when the result is read: read it here, so that a
+            # stored program that cannot run is dropped rather than failing the caller
+            return jax.block_until_ready(program(*dynamic))
         except Exception:
             _give_up(self._loaded.pop(memory_key, None))
             return self._jitted(*args, **kwargs)
 
     def _program(self, memory_key, positional, static, dynamic, treedef, signature):
+        """(program, output of its first run or None); (None, None): use plain jit."""
         if patched_modules():
-            return None
+            return None, None
         described = [describe(static), describe_tree(treedef), self._name]
         if None in described:
-            return None
+            return None, None
         key = hashlib.sha256("\n".join(described + [repr(signature)]).encode()).hexdigest()
         path = _root / f"{key}.bin"
         in_tree = jax.tree_util.tree_structure((dynamic, {}))
-        program = _load(path, in_tree)
+        program, out = _load(path, in_tree), None
         counts["loaded" if program is not None else "compiled"] += 1
         if program is None:
-            program = _compile_and_save(self._jitted, positional, path)
+            program, out = _compile_and_save(self._jitted, positional, dynamic, in_tree, path)
         if program is not None:
             program.store_path = path
             self._loaded[memory_key] = program
-        return program
+        return program, out
 
 
 class _Loaded:
@@ -382,28 +388,67 @@ def _load(path, in_tree):
         return None
 
 
-def _compile_and_save(jitted, positional, path):
-    """Compile without JAX's persistent cache (an executable loaded from it cannot be
-    serialized again: it fails to run once loaded), then write the store's file."""
+def _compile_and_save(jitted, positional, dynamic, in_tree, path):
+    """Compile (without JAX's persistent cache), run, and write the store's file only when a
+    copy read back from those bytes gives the same output to the bit. An executable that JAX
+    took from its own cache, or from this process's memory of one (a plain jit call of the
+    same program), serializes into bytes that load but do not run ("Function ... not
+    found"): the check keeps those out.
+    Returns (the compiled program, its output), or (None, None) to leave it to jax.jit."""
     from jax.experimental import serialize_executable
 
-    was = jax.config.jax_enable_compilation_cache
-    jax.config.update("jax_enable_compilation_cache", False)
     try:
-        compiled = jitted.lower(*positional).compile()
+        with _without_jax_cache():
+            compiled = jitted.lower(*positional).compile()
+        out = jax.block_until_ready(compiled(*dynamic))
     except Exception:
-        return None  # jit raises it again, with its own message
-    finally:
-        jax.config.update("jax_enable_compilation_cache", was)
+        return None, None  # jit raises it again, with its own message
+    if not lapack_ready():
+        return _Loaded(compiled), out
     try:
         serialized, _, out_tree = serialize_executable.serialize(compiled)
-        blob = pickle.dumps((serialized, out_tree), protocol=pickle.HIGHEST_PROTOCOL)
-        with tempfile.NamedTemporaryFile(dir=path.parent, delete=False, suffix=".tmp") as f:
-            f.write(blob)
-        os.replace(f.name, path)
+        copy = serialize_executable.deserialize_and_load(
+            serialized, in_tree, out_tree, execution_devices=jax.devices()[:1])
+        if same_bits(out, jax.block_until_ready(copy(*dynamic))):
+            blob = pickle.dumps((serialized, out_tree), protocol=pickle.HIGHEST_PROTOCOL)
+            with tempfile.NamedTemporaryFile(dir=path.parent, delete=False, suffix=".tmp") as f:
+                f.write(blob)
+            os.replace(f.name, path)
     except Exception:
-        pass  # not serializable here, or the folder is read-only: still run it
-    return _Loaded(compiled)
+        pass  # not serializable here, or the folder is read-only: run it all the same
+    return _Loaded(compiled), out
+
+
+@contextlib.contextmanager
+def _without_jax_cache():
+    """JAX decides once per process whether its persistent cache is in use (the setting
+    alone cannot turn it off later): answer "no" to that question while compiling. Where
+    this JAX has no such function the compile may come from its cache, and the check in
+    _compile_and_save then keeps the bytes off disk."""
+    try:
+        from jax._src import compilation_cache
+        used = compilation_cache.is_cache_used
+    except (ImportError, AttributeError):
+        yield
+        return
+    compilation_cache.is_cache_used = lambda backend: False
+    try:
+        yield
+    finally:
+        compilation_cache.is_cache_used = used
+
+
+def same_bits(a, b):
+    """Two pytrees of arrays with the same structure, shapes, dtypes and bytes."""
+    leaves_a, tree_a = jax.tree_util.tree_flatten(a)
+    leaves_b, tree_b = jax.tree_util.tree_flatten(b)
+    if tree_a != tree_b:
+        return False
+    for x, y in zip(leaves_a, leaves_b):
+        x, y = np.asarray(x), np.asarray(y)
+        if x.dtype != y.dtype or x.shape != y.shape or x.tobytes() != y.tobytes():
+            return False
+    return True
 
 
 def _unlink(path):

@@ -144,13 +144,25 @@ def _animation(kind):
     if kind == "race":
         race = {m: ik.solve(ARM, [3.5, 1.0], START, method=m, max_iter=60) for m in ("jt", "pinv", "dls")}
         return plot.animate_race(ARM, race, [3.5, 1.0], max_frames=6)
+    if kind == "clips":  # the camera follows the hips: the drawing moves, the axes do not
+        from ikteach import bvh, character_plot, skeleton
+
+        sk, motion = bvh.load(bvh.walk_path())
+        rig = skeleton.rig(sk)
+        root, theta = skeleton.angles(rig, motion.frames[:40])
+        points = skeleton.world_points(rig, root, theta)
+        feet = [rig.points.index("LeftFoot"), rig.points.index("RightFoot")]
+        contact = points[:, feet, 1] < 12.0
+        return character_plot.animate_clips(rig, [points, points + [0, 3, 0]], ["a", "b"], root,
+                                            contact=contact, feet=feet, every=8,
+                                            footprints=points[contact.any(1), feet[0]])
     tree = buss_trees.y_tree()
     times = buss_trees.times(24)[::6]
     thetas = np.linspace(0.0, 0.8, len(times))[:, None] * np.ones(tree.n_joints)
     return tree_plot.animate_tree(tree, thetas, buss_trees.y_targets(times), times=times, title="Y")
 
 
-@pytest.mark.parametrize("kind", ["solve", "race", "tree"])
+@pytest.mark.parametrize("kind", ["solve", "race", "tree", "clips"])
 def test_frame_pngs_match_full_redraws_except_where_moving_parts_overlap(kind, monkeypatch):
     """frame_pngs draws the still parts once: each frame must equal a full redraw of it,
     except inside the moving artists (painted over, not under, what stays still). A changing
@@ -176,6 +188,23 @@ def test_frame_pngs_match_full_redraws_except_where_moving_parts_overlap(kind, m
         differs = np.any(full != frame, axis=-1)
         assert not np.any(differs & ~inside), f"frame {j} differs outside its moving artists"
         assert differs.mean() < 0.002, f"frame {j}: {differs.mean():.4f} of the pixels differ"
+
+
+def test_save_gif_writes_every_frame_as_drawn_by_frame_pngs(tmp_path):
+    from PIL import Image
+
+    anim = _animation("clips")
+    path = plot.save_gif(anim, tmp_path / "walk.gif", fps=5, dpi=40)
+    gif = Image.open(path)
+    assert gif.n_frames == len(anim.iterations) == 5 and gif.info["duration"] == 200
+    assert gif.size == (round(7.2 * 40), round(5.8 * 40))
+    dpi = anim._fig.dpi
+    assert dpi != 40  # the figure's own dpi is given back
+    gif.seek(2)
+    anim._fig.set_dpi(40)
+    png = _png_pixels(plot.frame_pngs(anim)[2])
+    anim._fig.set_dpi(dpi)
+    assert np.abs(np.asarray(gif.convert("RGB"), float) - png[..., :3]).mean() < 8  # palette
 
 
 def test_to_html_embeds_the_blitted_frames_and_plays_like_to_jshtml():

@@ -60,6 +60,50 @@ def test_a_second_process_loads_every_program_and_gets_the_same_bits(tmp_path):
     assert plain["dls pose"][0] == "converged" and plain["jt"][0] == "converged"
 
 
+MEMO_SCRIPT = """
+import sys, numpy as np, ikteach as ik
+from ikteach import program_store
+ik.notebook.compilation_cache()
+arm = ik.planar_chain([1.0, 0.7, 0.4])
+if sys.argv[1] == "plain first":  # jax.jit runs it first (from JAX's cache), then the store
+    root, program_store._root = program_store._root, None
+    ik.solve(arm, [1.2, 0.9], np.full(3, 0.2), method="jt")
+    program_store._root = root
+r = ik.solve(arm, [1.2, 0.9], np.full(3, 0.2), method="jt")
+print(r.status, r.iterations, float(r.error).hex(), "+".join(sorted(program_store.counts)))
+"""
+
+
+def test_an_executable_from_jaxs_cache_is_never_stored(tmp_path):
+    """JAX hands back an executable it loaded from its own cache (here: from its memory of
+    the plain jit call) and that one serializes into bytes that load but cannot run. The
+    store checks a copy read back from the bytes before writing them."""
+    def run(*args, store="on"):
+        env = dict(os.environ, IKTEACH_JAX_CACHE=str(tmp_path), IKTEACH_PROGRAM_STORE=store)
+        done = subprocess.run([sys.executable, "-c", MEMO_SCRIPT, *args], capture_output=True,
+                              text=True, env=env, timeout=300)
+        assert done.returncode == 0 and "Warning" not in done.stderr, done.stderr[-3000:]
+        return done.stdout.split()
+
+    plain = run("", store="off")  # fills JAX's cache
+    first = run("plain first")
+    assert first[-1] == "compiled"  # compiled, checked, not written
+    assert list(tmp_path.glob("programs/*/*.bin")) == []
+    second = run("")
+    assert second[:3] == first[:3] == plain[:3]
+    assert second[-1] == "compiled" and len(list(tmp_path.glob("programs/*/*.bin"))) == 1
+    assert run("") == second[:3] + ["loaded"]
+
+
+def test_same_bits_tells_any_difference():
+    a = {"x": np.arange(3.0), "n": np.int64(2)}
+    assert program_store.same_bits(a, {"x": np.arange(3.0), "n": np.int64(2)})
+    assert not program_store.same_bits(a, {"x": np.array([0.0, 1.0, np.nextafter(2.0, 3.0)]), "n": np.int64(2)})
+    assert not program_store.same_bits(a, {"x": np.arange(3), "n": np.int64(2)})
+    assert not program_store.same_bits(a, {"x": np.arange(3.0), "m": np.int64(2)})
+    assert program_store.same_bits(np.array([np.nan]), np.array([np.nan]))
+
+
 @pytest.fixture
 def store(tmp_path, monkeypatch):
     """A fresh store for this test only."""
