@@ -5,6 +5,7 @@ import pytest
 from jax import monitoring
 
 import ikteach as ik
+from ikteach import program_store
 from ikteach.kinematics import end_path
 
 ARM = ik.planar_chain([1.0, 1.0, 1.0])
@@ -32,9 +33,18 @@ def varied_solves(rng, count):
     return results
 
 
-def test_the_counter_sees_a_compilation():
-    before = len(COMPILES)
+def programs_made():
+    """Compilations, and programs the store loaded or compiled (ikteach/program_store.py)."""
+    return len(COMPILES) + sum(program_store.counts.values())
+
+
+def test_the_counter_sees_a_compilation(monkeypatch):
+    before = programs_made()
     ik.solve(ARM, [1.0, 1.0], START, max_iter=7)  # a max_iter no other test uses
+    assert programs_made() > before
+    monkeypatch.setattr(program_store, "_root", None)  # jax.jit alone
+    before = len(COMPILES)
+    ik.solve(ARM, [1.0, 1.0], START, max_iter=8)
     assert len(COMPILES) > before
 
 
@@ -42,11 +52,12 @@ def test_twenty_varied_solves_compile_nothing_new():
     rng = np.random.default_rng(3)
     for res in varied_solves(rng, len(METHODS)):  # the first solve of each method compiles
         end_path(ARM, res.trace.theta)
-    before = len(COMPILES)
+    before, store_before = len(COMPILES), dict(program_store.counts)
     results = varied_solves(rng, 20)
     for res in results:
         end_path(ARM, res.trace.theta)  # traces of every length: the demo draws them
     assert len(COMPILES) == before, COMPILES[before:]
+    assert dict(program_store.counts) == store_before  # nothing loaded from disk either
     assert len({res.iterations for res in results}) > 5  # iteration counts did vary
     assert {res.status for res in results} >= {"converged", "stalled"}
 
