@@ -27,8 +27,9 @@ def _pv():
 
     apply_pyvista_choice()
     try:  # vtk's X11 warnings go straight to stderr; keep errors only
-        import vtk
-        vtk.vtkLogger.SetStderrVerbosity(vtk.vtkLogger.VERBOSITY_ERROR)
+        from vtkmodules.vtkCommonCore import vtkLogger  # not `import vtk`: every module, 0.5 s
+
+        vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_ERROR)
     except (ImportError, AttributeError):
         pass
     return pv
