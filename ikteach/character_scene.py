@@ -2,7 +2,7 @@
 ik.scene.show (a static PNG off screen, pyvista's live view in a live Jupyter)."""
 import numpy as np
 
-from .scene import WINDOW, _pv
+from .scene import WINDOW, _pv, add_meshes
 
 BONE_COLORS = {"Left": "#4c72b0", "Right": "#dd8452"}
 OTHER = "#777777"
@@ -21,18 +21,18 @@ def character_scene(rig, points, targets=None, window_size=WINDOW, plotter=None)
     height = np.ptp(points[:, 1])
     p.add_mesh(pv.Plane(center=(centre[0], 0.0, centre[2]), direction=UP, i_size=1.6 * height,
                         j_size=1.6 * height), color="#eeeeee", render=False)
+    bones = []
     for a, b in rig.bones():
         name = rig.points[b] if isinstance(rig.points[b], str) else rig.points[b][0]
         colour = next((c for side, c in BONE_COLORS.items() if name.startswith(side)), OTHER)
         if np.linalg.norm(points[b] - points[a]) > 1e-9:
-            p.add_mesh(pv.Tube(pointa=points[a], pointb=points[b], radius=0.018 * height, n_sides=16),
-                       color=colour, smooth_shading=True, render=False)
-    for q in points:
-        p.add_mesh(pv.Sphere(center=q, radius=0.025 * height), color="#333333", smooth_shading=True,
-                   render=False)
+            bones.append((pv.Tube(pointa=points[a], pointb=points[b], radius=0.018 * height,
+                                  n_sides=16), colour))
+    balls = [(pv.Sphere(center=q, radius=0.025 * height), "#333333") for q in points]
+    add_meshes(p, bones + balls, smooth_shading=True)  # one actor per colour
     if targets is not None:
-        for t in np.asarray(targets, dtype=float).reshape(-1, 3):
-            p.add_mesh(pv.Sphere(center=t, radius=0.03 * height), color="#8172b3", opacity=0.6, render=False)
+        add_meshes(p, [(pv.Sphere(center=t, radius=0.03 * height), "#8172b3")
+                       for t in np.asarray(targets, dtype=float).reshape(-1, 3)], opacity=0.6)
     eye = centre + height * np.array([1.3, 0.35, 1.9])
     p.camera_position = [tuple(eye), tuple(centre), tuple(UP)]
     p.camera.view_angle = 30.0

@@ -40,7 +40,7 @@ import warnings
 import jax
 import numpy as np
 
-FORMAT = "ikteach-program-2"
+FORMAT = "ikteach-program-3"
 SUBFOLDER = "programs"
 STORE_ENV = "IKTEACH_PROGRAM_STORE"  # "off": JAX's persistent cache only
 STALE_DAYS = 14  # env folders (other versions, other source) untouched this long are removed
@@ -178,6 +178,9 @@ def describe(obj, depth=0):
         return f"{obj.dtype.str}:{obj!r}"
     if isinstance(obj, np.dtype):
         return f"dtype:{obj.str}"
+    if isinstance(obj, jax.sharding.Mesh):  # solve_batch's split over the CPU devices
+        devices = [(d.platform, d.id) for d in obj.devices.flat]
+        return f"mesh:{obj.axis_names!r}:{obj.devices.shape}:{devices}"
     if kind in (tuple, list):
         parts = [describe(x, depth + 1) for x in obj]
         return None if None in parts else f"{kind.__name__}({','.join(parts)})"
@@ -379,9 +382,10 @@ def _load(path, in_tree):
     except OSError:
         return None
     try:
-        serialized, out_tree = pickle.loads(blob)
+        serialized, out_tree, device_ids = pickle.loads(blob)
+        by_id = {d.id: d for d in jax.devices()}
         compiled = serialize_executable.deserialize_and_load(
-            serialized, in_tree, out_tree, execution_devices=jax.devices()[:1])
+            serialized, in_tree, out_tree, execution_devices=[by_id[i] for i in device_ids])
         return _Loaded(compiled)
     except Exception:  # a truncated or foreign file: compile again
         _unlink(path)
@@ -407,10 +411,12 @@ def _compile_and_save(jitted, positional, dynamic, in_tree, path):
         return _Loaded(compiled), out
     try:
         serialized, _, out_tree = serialize_executable.serialize(compiled)
+        devices = list(compiled._executable.xla_executable.local_devices())  # in its order
         copy = serialize_executable.deserialize_and_load(
-            serialized, in_tree, out_tree, execution_devices=jax.devices()[:1])
+            serialized, in_tree, out_tree, execution_devices=devices)
         if same_bits(out, jax.block_until_ready(copy(*dynamic))):
-            blob = pickle.dumps((serialized, out_tree), protocol=pickle.HIGHEST_PROTOCOL)
+            blob = pickle.dumps((serialized, out_tree, [d.id for d in devices]),
+                                protocol=pickle.HIGHEST_PROTOCOL)
             with tempfile.NamedTemporaryFile(dir=path.parent, delete=False, suffix=".tmp") as f:
                 f.write(blob)
             os.replace(f.name, path)

@@ -79,6 +79,17 @@ def trail_mesh(points, scale):
     return pv.lines_from_points(points).tube(radius=0.008 * scale, n_sides=8)
 
 
+def add_meshes(plotter, parts, **style):
+    """Add [(mesh, colour), ...] as one actor per colour, the parts of a colour merged into one
+    mesh (they stay separate pieces): a few actors to build and draw instead of one per part."""
+    by_colour = {}
+    for mesh, colour in parts:
+        by_colour.setdefault(colour, []).append(mesh)
+    for colour, meshes in by_colour.items():
+        merged = meshes[0].append_polydata(*meshes[1:]) if len(meshes) > 1 else meshes[0]
+        plotter.add_mesh(merged, color=colour, render=False, **style)
+
+
 def _camera(arm, scale):
     base = np.asarray(arm.base, dtype=float)
     focus = base + np.array([0.0, 0.0, 0.3 * scale])
@@ -103,18 +114,14 @@ def scene(arm, theta, target=None, trail=None, window_size=WINDOW, ghost=None, p
                      direction=(0, 0, 1), i_size=2.4 * scale, j_size=2.4 * scale)
     p.add_mesh(floor, color="#f2f2f2", ambient=0.6, diffuse=0.4, render=False)
     if ghost is not None:
-        for mesh, colour in arm_meshes(arm, ghost, scale):
-            p.add_mesh(mesh, color=colour, opacity=0.25, render=False)
-    for mesh, colour in arm_meshes(arm, theta, scale):
-        p.add_mesh(mesh, color=colour, smooth_shading=True, render=False)
+        add_meshes(p, arm_meshes(arm, ghost, scale), opacity=0.25)
+    add_meshes(p, arm_meshes(arm, theta, scale), smooth_shading=True)
     _, _, T = frames(arm, theta)
-    for mesh, colour in triad(T, 0.2 * scale):
-        p.add_mesh(mesh, color=colour, render=False)
+    add_meshes(p, triad(T, 0.2 * scale))
     if target is not None:
         target = np.asarray(target, dtype=float)
         if target.shape == (4, 4):
-            for mesh, colour in triad(target, 0.28 * scale):
-                p.add_mesh(mesh, color=colour, opacity=0.5, render=False)
+            add_meshes(p, triad(target, 0.28 * scale), opacity=0.5)
             centre = target[:3, 3]
         else:
             centre = np.append(target, 0.0)[:3] if target.shape == (2,) else target
