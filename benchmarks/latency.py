@@ -2,11 +2,13 @@
 after the first of their shape (which compiles), and how long the first one took.
 
     .venv/bin/python benchmarks/latency.py [--n 40] [--map-n 128] [--skip-demo] [--skip-map]
+                                           [--skip-new-kernel]
 
 Rows: ik.solve on the 3-link planar arm for each method over random targets (some out
 of reach) with varied damping, tolerance and clamp; ik.demo.Demo().update(x=..., y=...)
 per method (solve + PNG render); the notebook-07 live map (128 x 128 solve_batch + redraw)
-per method and lambda. Goals (issue 9): solve p95 < 10 ms, demo p95 < 50 ms, map < 0.5 s.
+per method and lambda; the first solve per method in a new process with the compilation
+cache warm, with and without the program store. Goals (issue 9): solve p95 < 10 ms, demo p95 < 50 ms, map < 0.5 s.
 """
 import argparse
 import time
@@ -89,12 +91,54 @@ def map_rows(n, grid_n, rng):
         row(f"map {method}", first, times, 500)
 
 
+NEW_KERNEL = """
+import json, sys, time
+import numpy as np
+import ikteach as ik
+ik.notebook.compilation_cache()
+arm, out = ik.planar_chain([1.0, 1.0, 1.0]), {}
+for method in %r:
+    t0 = time.perf_counter()
+    ik.solve(arm, [2.0, 1.0], np.array([0.1, 0.2, 0.3]), method=method, max_iter=300)
+    out[method] = time.perf_counter() - t0
+print(json.dumps(out))
+"""
+
+
+def new_kernel_rows():
+    """The first solve per method in a new process (a lecturer reopening the notebook), the
+    compilation cache warm: JAX's cache alone, and with ikteach's program store."""
+    import json
+    import os
+    import subprocess
+    import sys
+    import tempfile
+
+    def run(cache, store):
+        env = dict(os.environ, IKTEACH_JAX_CACHE=cache, IKTEACH_PROGRAM_STORE=store)
+        done = subprocess.run([sys.executable, "-c", NEW_KERNEL % (METHODS,)], env=env,
+                              capture_output=True, text=True, check=True)
+        return json.loads(done.stdout.splitlines()[-1])
+
+    print("\nfirst solve per method in a new process, cache warm (the process run once before)")
+    print(f"| {'method':<8} | {'cold ms':>8} | {'JAX cache ms':>12} | {'+ program store ms':>18} |")
+    print(f"|{'-' * 10}|{'-' * 10}|{'-' * 14}|{'-' * 20}|")
+    with tempfile.TemporaryDirectory() as jax_only, tempfile.TemporaryDirectory() as store:
+        cold = run(jax_only, "off")
+        warm = run(jax_only, "off")
+        run(store, "on")
+        stored = run(store, "on")
+    for m in METHODS:
+        print(f"| {m:<8} | {1e3 * cold[m]:>8.0f} | {1e3 * warm[m]:>12.0f} | {1e3 * stored[m]:>18.0f} |")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--n", type=int, default=40, help="timed calls per row")
     ap.add_argument("--map-n", type=int, default=128, help="live map grid side")
     ap.add_argument("--skip-demo", action="store_true")
     ap.add_argument("--skip-map", action="store_true")
+    ap.add_argument("--skip-new-kernel", action="store_true")
     args = ap.parse_args()
     rng = np.random.default_rng(0)
     print(f"import ikteach: {IMPORT_S * 1e3:.0f} ms (this process, numpy included)")
@@ -104,6 +148,8 @@ def main():
         demo_rows(args.n, rng)
     if not args.skip_map:
         map_rows(args.n, args.map_n, rng)
+    if not args.skip_new_kernel:
+        new_kernel_rows()
 
 
 if __name__ == "__main__":

@@ -40,7 +40,7 @@ import warnings
 import jax
 import numpy as np
 
-FORMAT = "ikteach-program-3"
+FORMAT = "ikteach-program-4"
 SUBFOLDER = "programs"
 STORE_ENV = "IKTEACH_PROGRAM_STORE"  # "off": JAX's persistent cache only
 STALE_DAYS = 14  # env folders (other versions, other source) untouched this long are removed
@@ -375,14 +375,14 @@ def lapack_ready():
 def _load(path, in_tree):
     from jax.experimental import serialize_executable
 
-    if not lapack_ready():
-        return None
     try:
         blob = path.read_bytes()
     except OSError:
         return None
     try:
-        serialized, out_tree, device_ids = pickle.loads(blob)
+        serialized, out_tree, device_ids, needs_lapack = pickle.loads(blob)
+        if needs_lapack and not lapack_ready():
+            return None
         by_id = {d.id: d for d in jax.devices()}
         compiled = serialize_executable.deserialize_and_load(
             serialized, in_tree, out_tree, execution_devices=[by_id[i] for i in device_ids])
@@ -415,8 +415,8 @@ def _compile_and_save(jitted, positional, dynamic, in_tree, path):
         copy = serialize_executable.deserialize_and_load(
             serialized, in_tree, out_tree, execution_devices=devices)
         if same_bits(out, jax.block_until_ready(copy(*dynamic))):
-            blob = pickle.dumps((serialized, out_tree, [d.id for d in devices]),
-                                protocol=pickle.HIGHEST_PROTOCOL)
+            blob = pickle.dumps((serialized, out_tree, [d.id for d in devices],
+                                 calls_lapack(compiled)), protocol=pickle.HIGHEST_PROTOCOL)
             with tempfile.NamedTemporaryFile(dir=path.parent, delete=False, suffix=".tmp") as f:
                 f.write(blob)
             os.replace(f.name, path)
@@ -442,6 +442,15 @@ def _without_jax_cache():
         yield
     finally:
         compilation_cache.is_cache_used = used
+
+
+def calls_lapack(compiled):
+    """Does the program call jaxlib's LAPACK kernels (SVD, solves)? Those need lapack_ready()
+    before it runs, which imports scipy.linalg (0.25 s): loads of other programs skip it."""
+    try:
+        return "lapack_" in compiled.as_text()
+    except Exception:
+        return True
 
 
 def same_bits(a, b):
