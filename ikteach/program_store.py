@@ -448,7 +448,7 @@ def calls_lapack(compiled):
     """Does the program call jaxlib's LAPACK kernels (SVD, solves)? Those need lapack_ready()
     before it runs, which imports scipy.linalg (0.25 s): loads of other programs skip it."""
     try:
-        return "lapack_" in compiled.as_text()
+        return 'custom_call_target="lapack_' in compiled.as_text()
     except Exception:
         return True
 
