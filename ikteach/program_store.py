@@ -69,6 +69,7 @@ VERSIONED_ROOTS = frozenset({"ikteach", "jax", "jaxlib", "numpy", "builtins", "m
                              "operator", "functools"})
 
 _root = None  # the folder, once open() was called with a trusted cache
+_works = None  # store_works(), once per process
 _broken = False  # a stored program misbehaved: plain jax.jit for the rest of the process
 _source = None
 _lapack_ready = None
@@ -330,9 +331,12 @@ class StoredProgram:
         path = _root / f"{key}.bin"
         in_tree = jax.tree_util.tree_structure((dynamic, {}))
         program, out = _load(path, in_tree), None
-        counts["loaded" if program is not None else "compiled"] += 1
-        if program is None:
+        if program is not None:
+            counts["loaded"] += 1
+        else:
             program, out = _compile_and_save(self._jitted, positional, dynamic, in_tree, path)
+            if program is not None:
+                counts["compiled"] += 1
         if program is not None:
             program.store_path = path
             self._loaded[memory_key] = program
@@ -401,6 +405,8 @@ def _compile_and_save(jitted, positional, dynamic, in_tree, path):
     Returns (the compiled program, its output), or (None, None) to leave it to jax.jit."""
     from jax.experimental import serialize_executable
 
+    if not store_works():
+        return None, None  # plain jit, through JAX's cache
     try:
         with _without_jax_cache():
             compiled = jitted.lower(*positional).compile()
@@ -442,6 +448,34 @@ def _without_jax_cache():
         yield
     finally:
         compilation_cache.is_cache_used = used
+
+
+def _round_trip(fun, *args):
+    """Compile fun (past JAX's cache), write, read back and run it: the same bits?"""
+    from jax.experimental import serialize_executable
+
+    with _without_jax_cache():
+        compiled = jax.jit(fun).lower(*args).compile()
+    out = jax.block_until_ready(compiled(*args))
+    serialized, in_tree, out_tree = serialize_executable.serialize(compiled)
+    devices = list(compiled._executable.xla_executable.local_devices())
+    _, out_tree = pickle.loads(pickle.dumps((None, out_tree)))
+    copy = serialize_executable.deserialize_and_load(serialized, in_tree, out_tree,
+                                                     execution_devices=devices)
+    return same_bits(out, jax.block_until_ready(copy(*args)))
+
+
+def store_works():
+    """Once per process, before the first program is compiled for the store: can this JAX
+    write a program and read it back (a one-line program, about 30 ms)? If not, programs
+    stay with jax.jit and JAX's own cache, which the store's compiles bypass."""
+    global _works
+    if _works is None:
+        try:
+            _works = _round_trip(lambda x, n: (x * n).sum(), np.arange(3.0), 2)
+        except Exception:
+            _works = False
+    return _works
 
 
 def calls_lapack(compiled):

@@ -167,6 +167,24 @@ def test_a_program_that_fails_to_run_falls_back_to_jit(store):
         assert float(program(jnp.arange(3.0), 2.0, power=2)) == 10.0  # plain jit, quietly
 
 
+def test_a_jax_that_cannot_read_programs_back_keeps_jit_and_its_cache(store, monkeypatch):
+    def fails(*args):
+        raise RuntimeError("Compilation does not support serialization")
+
+    from jax.experimental import serialize_executable
+
+    monkeypatch.setattr(program_store, "_works", None)
+    monkeypatch.setattr(serialize_executable, "serialize", fails)
+    program = xla.jit(square_sum, static_argnames=("power",))
+    assert float(program(jnp.arange(3.0), 2.0, power=2)) == 10.0
+    assert store.counts == {"plain": 1} and not list(store._root.glob("*.bin"))
+    assert program_store._works is False
+
+
+def test_the_round_trip_check_passes_here():
+    assert program_store.store_works()
+
+
 def test_a_students_step_function_is_never_stored(store):
     arm = ik.planar_chain([1.0, 1.0])
     res = ik.solve(arm, [1.0, 1.0], [0.3, 0.3], method=lambda J, e: 0.5 * J.T @ e)
