@@ -423,9 +423,7 @@ def _compile_and_save(jitted, positional, dynamic, in_tree, path):
         if same_bits(out, jax.block_until_ready(copy(*dynamic))):
             blob = pickle.dumps((serialized, out_tree, [d.id for d in devices],
                                  calls_lapack(compiled)), protocol=pickle.HIGHEST_PROTOCOL)
-            with tempfile.NamedTemporaryFile(dir=path.parent, delete=False, suffix=".tmp") as f:
-                f.write(blob)
-            os.replace(f.name, path)
+            _write(path, blob)
     except Exception:
         pass  # not serializable here, or the folder is read-only: run it all the same
     return _Loaded(compiled), out
@@ -498,6 +496,19 @@ def same_bits(a, b):
         if x.dtype != y.dtype or x.shape != y.shape or x.tobytes() != y.tobytes():
             return False
     return True
+
+
+def _write(path, blob):
+    """Write whole or not at all (another kernel may be reading or writing the same file)."""
+    with tempfile.NamedTemporaryFile(dir=path.parent, delete=False, suffix=".tmp") as f:
+        temporary = pathlib.Path(f.name)
+        try:
+            f.write(blob)
+        except OSError:
+            f.close()
+            _unlink(temporary)
+            raise
+    os.replace(temporary, path)
 
 
 def _unlink(path):
