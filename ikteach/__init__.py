@@ -29,6 +29,7 @@ from .sdls import sdls_step, GAMMA_MAX  # noqa: E402
 from .ccd import ccd_sweep, ccd_angle  # noqa: E402
 from .fabrik import fabrik_pass  # noqa: E402
 from .tree import Tree, tree, tree_fk, tree_frames, tree_jacobian, tree_jacobian_autodiff  # noqa: E402
+from .tree import tree_jacobian_from_frames  # noqa: E402
 from .track import track, TrackResult  # noqa: E402
 from .jitter import jitter, jitter_per_step  # noqa: E402
 from . import stop_rules, settle  # noqa: E402
@@ -78,6 +79,7 @@ __all__ = [
     "StopSolve", "check",
     "sdls_step", "GAMMA_MAX", "ccd_sweep", "ccd_angle", "fabrik_pass",
     "Tree", "tree", "tree_fk", "tree_frames", "tree_jacobian", "tree_jacobian_autodiff",
+    "tree_jacobian_from_frames",
     "track", "TrackResult", "jitter", "jitter_per_step", "stop_rules", "settle", "buss_trees", "tree_plot", "plot", "demo",
     "fk_pose", "rotation_log", "rotation_exp", "pose_errors", "make_pose", "PoseTask",
     "ur5", "iiwa14", "robots", "scene", "workspace", "live_map",

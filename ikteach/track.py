@@ -17,7 +17,7 @@ from .limits import cap_step
 from .pinv import DEFAULT_RCOND
 from .sdls import GAMMA_MAX
 from .levels import DEFAULT_REST_GAIN
-from .solve import DEFAULT_DAMPING, Settings, resolve_method, with_extras
+from .solve import DEFAULT_DAMPING, Settings, linearize, resolve_method, with_extras
 from .tasks import task_for
 from . import xla
 
@@ -55,9 +55,10 @@ def _track(method, task, arm, targets, theta0, settings, d_max):
     block = getattr(task, "block_size", None)
 
     def step(theta, target):
-        e = task.error(arm, target, theta)
+        e, linearized = linearize(task, arm, target, theta)  # e and J from one walk
         e = clamp_blocks(e, block or e.shape[0], d_max)
-        delta = cap_step(method.delta(task, arm, target, theta, e, settings), settings.max_step)
+        delta = cap_step(method.delta(linearized, arm, target, theta, e, settings),
+                         settings.max_step)
         new = jnp.clip(theta + delta, settings.lower, settings.upper)  # joint limits
         theta = jnp.where(jnp.all(jnp.isfinite(new)), new, theta)  # never NaN: keep the last finite
         e_after = task.error(arm, target, theta)

@@ -138,7 +138,11 @@ def tree_jacobian(arm, theta):
 
     Block k, column j is z_j x (x_k - p_j) when joint j moves effector k, else 0.
     """
-    p, z, x = tree_frames(arm, theta)
+    return tree_jacobian_from_frames(arm, *tree_frames(arm, theta))
+
+
+def tree_jacobian_from_frames(arm, p, z, x):
+    """tree_jacobian from tree_frames' joint positions p, axes z and effector positions x."""
     blocks = jnp.cross(z[None, :, :], x[:, None, :] - p[None, :, :])  # (m, n, 3)
     blocks = jnp.where(jnp.asarray(ancestors(arm))[:, :, None], blocks, 0.0)
     return jnp.transpose(blocks, (0, 2, 1)).reshape(3 * arm.n_effectors, arm.n_joints)
@@ -178,6 +182,11 @@ class TreeTask:
 
     def jacobian(self, arm, theta):
         return tree_jacobian(arm, theta)
+
+    def error_and_jacobian(self, arm, target, theta):
+        """e and J from one walk of the tree (the solve and tracking loops need both)."""
+        p, z, x = tree_frames(arm, theta)
+        return (target - x).reshape(-1), tree_jacobian_from_frames(arm, p, z, x)
 
     def length_scale(self, arm):
         return tree_size(arm)

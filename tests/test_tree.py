@@ -134,3 +134,17 @@ def test_tree_animation_titles_each_frame_with_its_time_and_has_a_still():
     anim._draw_frame(1)
     assert ax.get_title() == "Y tree, SDLS: t =  0.25 s"
     assert plot.still_png(anim)[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("arm", [Y, DOUBLE_Y], ids=["Y", "double Y"])
+def test_error_and_jacobian_from_one_walk_equal_the_two_calls_to_the_bit(arm):
+    """Solves and tracks take e and J of a tree from one tree_frames walk."""
+    from ikteach.tree import TreeTask
+
+    rng = np.random.default_rng(2)
+    theta = rng.uniform(-1, 1, arm.n_joints)
+    target = np.asarray(ik.tree_fk(arm, rng.uniform(-1, 1, arm.n_joints)))
+    task = TreeTask()
+    e, J = task.error_and_jacobian(arm, target, theta)
+    assert np.asarray(e).tobytes() == np.asarray(task.error(arm, target, theta)).tobytes()
+    assert np.asarray(J).tobytes() == np.asarray(task.jacobian(arm, theta)).tobytes()
