@@ -136,15 +136,24 @@ def test_tree_animation_titles_each_frame_with_its_time_and_has_a_still():
     assert plot.still_png(anim)[:8] == b"\x89PNG\r\n\x1a\n"
 
 
-@pytest.mark.parametrize("arm", [Y, DOUBLE_Y], ids=["Y", "double Y"])
-def test_error_and_jacobian_from_one_walk_equal_the_two_calls_to_the_bit(arm):
-    """Solves and tracks take e and J of a tree from one tree_frames walk."""
+def _tree_tasks():
+    from ikteach.clip_ik import MaskedTreeTask
     from ikteach.tree import TreeTask
 
+    mask = tuple(float(k % 3 != 0) for k in range(DOUBLE_Y.n_joints))
+    return [TreeTask(), MaskedTreeTask(mask=mask)]
+
+
+@pytest.mark.parametrize("task", _tree_tasks(), ids=["tree", "masked tree (clip_ik)"])
+@pytest.mark.parametrize("arm", [Y, DOUBLE_Y], ids=["Y", "double Y"])
+def test_error_and_jacobian_from_one_walk_equal_the_two_calls_to_the_bit(arm, task):
+    """Solves and tracks take e and J of a tree from one tree_frames walk: a task that
+    changes jacobian() (clip_ik's mask) must change error_and_jacobian() too."""
     rng = np.random.default_rng(2)
     theta = rng.uniform(-1, 1, arm.n_joints)
     target = np.asarray(ik.tree_fk(arm, rng.uniform(-1, 1, arm.n_joints)))
-    task = TreeTask()
+    if len(getattr(task, "mask", ())) not in (0, arm.n_joints):
+        task = type(task)(mask=task.mask[: arm.n_joints])
     e, J = task.error_and_jacobian(arm, target, theta)
     assert np.asarray(e).tobytes() == np.asarray(task.error(arm, target, theta)).tobytes()
     assert np.asarray(J).tobytes() == np.asarray(task.jacobian(arm, theta)).tobytes()
