@@ -8,7 +8,8 @@ Rows: ik.solve on the 3-link planar arm for each method over random targets (som
 of reach) with varied damping, tolerance and clamp; ik.demo.Demo().update(x=..., y=...)
 per method (solve + PNG render); the notebook-07 live map (128 x 128 solve_batch + redraw)
 per method and lambda; the first solve per method in a new process with the compilation
-cache warm, with and without the program store. Goals (issue 9): solve p95 < 10 ms, demo p95 < 50 ms, map < 0.5 s.
+cache warm, with and without the program store.
+Goals (issue 9): solve p95 < 10 ms, demo p95 < 50 ms, map < 0.5 s.
 """
 import argparse
 import time

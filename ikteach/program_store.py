@@ -96,11 +96,6 @@ def open_store(cache_dir):
     return _root
 
 
-def close_store():
-    global _root
-    _root = None
-
-
 def _prune(base, keep):
     cutoff = time.time() - STALE_DAYS * 86400
     for folder in base.iterdir():
@@ -217,7 +212,7 @@ def describe(obj, depth=0):
     return None
 
 
-def describe_tree(treedef, depth=0):
+def describe_tree(treedef):
     """The pytree structure, node types and their static data included, or None."""
     data = treedef.node_data()
     if data is None:
@@ -226,7 +221,7 @@ def describe_tree(treedef, depth=0):
     name, aux_text = describe(node_type), describe(aux)
     if name is None or aux_text is None:
         return None
-    children = [describe_tree(c, depth + 1) for c in treedef.children()]
+    children = [describe_tree(c) for c in treedef.children()]
     return None if None in children else f"{name}[{aux_text}]({','.join(children)})"
 
 
@@ -267,7 +262,7 @@ class StoredProgram:
     """jax.jit(fun, static_argnames=...) whose executables also live in the store."""
 
     def __init__(self, fun, jitted, static_argnames=()):
-        self._fun, self._jitted = fun, jitted
+        self._jitted = jitted
         self._signature = inspect.signature(fun)
         params = self._signature.parameters.values()
         self._plain = any(p.kind not in (p.POSITIONAL_OR_KEYWORD, p.POSITIONAL_ONLY)
@@ -338,7 +333,6 @@ class StoredProgram:
             if program is not None:
                 counts["compiled"] += 1
         if program is not None:
-            program.store_path = path
             self._loaded[memory_key] = program
         return program, out
 
@@ -346,7 +340,7 @@ class StoredProgram:
 class _Loaded:
     """A Compiled with the file it came from (deleted should it fail)."""
 
-    def __init__(self, compiled, store_path=None):
+    def __init__(self, compiled, store_path):
         self.compiled, self.store_path = compiled, store_path
 
     def __call__(self, *args):
@@ -390,7 +384,7 @@ def _load(path, in_tree):
         by_id = {d.id: d for d in jax.devices()}
         compiled = serialize_executable.deserialize_and_load(
             serialized, in_tree, out_tree, execution_devices=[by_id[i] for i in device_ids])
-        return _Loaded(compiled)
+        return _Loaded(compiled, path)
     except Exception:  # a truncated or foreign file: compile again
         _unlink(path)
         return None
@@ -403,8 +397,6 @@ def _compile_and_save(jitted, positional, dynamic, in_tree, path):
     same program), serializes into bytes that load but do not run ("Function ... not
     found"): the check keeps those out.
     Returns (the compiled program, its output), or (None, None) to leave it to jax.jit."""
-    from jax.experimental import serialize_executable
-
     if not store_works():
         return None, None  # plain jit, through JAX's cache
     try:
@@ -413,20 +405,31 @@ def _compile_and_save(jitted, positional, dynamic, in_tree, path):
         out = jax.block_until_ready(compiled(*dynamic))
     except Exception:
         return None, None  # jit raises it again, with its own message
-    if not lapack_ready():
-        return _Loaded(compiled), out
     try:
-        serialized, _, out_tree = serialize_executable.serialize(compiled)
-        devices = list(compiled._executable.xla_executable.local_devices())  # in its order
-        copy = serialize_executable.deserialize_and_load(
-            serialized, in_tree, out_tree, execution_devices=devices)
-        if same_bits(out, jax.block_until_ready(copy(*dynamic))):
-            blob = pickle.dumps((serialized, out_tree, [d.id for d in devices],
-                                 calls_lapack(compiled)), protocol=pickle.HIGHEST_PROTOCOL)
+        blob = _checked_bytes(compiled, in_tree, dynamic, out)
+        if blob is not None:
             _write(path, blob)
     except Exception:
         pass  # not serializable here, or the folder is read-only: run it all the same
-    return _Loaded(compiled), out
+    return _Loaded(compiled, path), out
+
+
+def _checked_bytes(compiled, in_tree, args, out):
+    """The store's file for a compiled program that gave `out` on `args`, or None when a copy
+    read back from its bytes does not give the same output to the bit."""
+    from jax.experimental import serialize_executable
+
+    needs_lapack = calls_lapack(compiled)
+    if needs_lapack and not lapack_ready():
+        return None
+    serialized, _, out_tree = serialize_executable.serialize(compiled)
+    devices = list(compiled._executable.xla_executable.local_devices())  # in its order
+    copy = serialize_executable.deserialize_and_load(serialized, in_tree, out_tree,
+                                                     execution_devices=devices)
+    if not same_bits(out, jax.block_until_ready(copy(*args))):
+        return None
+    return pickle.dumps((serialized, out_tree, [d.id for d in devices], needs_lapack),
+                        protocol=pickle.HIGHEST_PROTOCOL)
 
 
 @contextlib.contextmanager
@@ -434,7 +437,7 @@ def _without_jax_cache():
     """JAX decides once per process whether its persistent cache is in use (the setting
     alone cannot turn it off later): answer "no" to that question while compiling. Where
     this JAX has no such function the compile may come from its cache, and the check in
-    _compile_and_save then keeps the bytes off disk."""
+    _checked_bytes then keeps the bytes off disk."""
     try:
         from jax._src import compilation_cache
         used = compilation_cache.is_cache_used
@@ -450,17 +453,10 @@ def _without_jax_cache():
 
 def _round_trip(fun, *args):
     """Compile fun (past JAX's cache), write, read back and run it: the same bits?"""
-    from jax.experimental import serialize_executable
-
     with _without_jax_cache():
         compiled = jax.jit(fun).lower(*args).compile()
     out = jax.block_until_ready(compiled(*args))
-    serialized, in_tree, out_tree = serialize_executable.serialize(compiled)
-    devices = list(compiled._executable.xla_executable.local_devices())
-    _, out_tree = pickle.loads(pickle.dumps((None, out_tree)))
-    copy = serialize_executable.deserialize_and_load(serialized, in_tree, out_tree,
-                                                     execution_devices=devices)
-    return same_bits(out, jax.block_until_ready(copy(*args)))
+    return _checked_bytes(compiled, jax.tree_util.tree_structure((args, {})), args, out) is not None
 
 
 def store_works():
@@ -521,7 +517,7 @@ def _unlink(path):
 def _give_up(program):
     """A stored program failed: remove its file and use plain jax.jit from now on."""
     global _broken
-    if program is not None and program.store_path is not None:
+    if program is not None:
         _unlink(program.store_path)
     if not _broken:
         _broken = True
