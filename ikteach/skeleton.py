@@ -12,6 +12,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from . import xla
 from ._validate import as_array
 from .bvh import POSITIONS, Skeleton
 from .tree import tree, tree_fk
@@ -163,7 +164,7 @@ def frames_from(rig, root, theta, like):
     return out
 
 
-@jax.jit
+@xla.jit  # kept whole on disk: a new kernel skips tracing the walk over every frame
 def _points(arm, root, theta):
     return root[:, None, :] + jax.vmap(lambda q: tree_fk(arm, q))(theta)
 

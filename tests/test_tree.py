@@ -5,7 +5,7 @@ from hypothesis import strategies as st
 
 import ikteach as ik
 from ikteach import buss_trees
-from ikteach.tree import ancestors
+from ikteach.tree import ancestors, depth_levels
 from strategies import random_trees
 
 Y = buss_trees.y_tree()
@@ -19,6 +19,39 @@ def test_stacked_jacobian_agrees_with_autodiff_on_random_trees(arm, seed):
     J = ik.tree_jacobian(arm, theta)
     assert J.shape == (3 * arm.n_effectors, arm.n_joints)
     np.testing.assert_allclose(J, ik.tree_jacobian_autodiff(arm, theta), atol=1e-10)
+
+
+def walk_joint_by_joint(arm, theta):
+    """tree_frames' formulas in numpy, one joint at a time in the order they are listed."""
+    rest, axes = np.asarray(arm.positions), np.asarray(arm.axes)
+    R, p, z = np.zeros((arm.n_joints, 3, 3)), np.zeros((arm.n_joints, 3)), np.zeros((arm.n_joints, 3))
+    for j, parent in enumerate(arm.parents):
+        Rp, pp = (np.eye(3), rest[j]) if parent < 0 else (R[parent], p[parent] + R[parent] @ (rest[j] - rest[parent]))
+        a = axes[j]
+        K = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+        R[j] = Rp @ (np.eye(3) + np.sin(theta[j]) * K + (1 - np.cos(theta[j])) * K @ K)
+        p[j], z[j] = pp, Rp @ a
+    on = list(arm.effector_parents)
+    x = p[on] + np.einsum("kab,kb->ka", R[on], np.asarray(arm.effectors) - rest[on])
+    return p, z, x
+
+
+FOREST = ik.tree(np.random.default_rng(5).normal(size=(7, 3)), np.random.default_rng(6).normal(size=(7, 3)),
+                 [-1, 0, -1, 1, 2, 4, 0], np.random.default_rng(7).normal(size=(3, 3)), [3, 5, 6])
+
+
+@given(st.one_of(random_trees(), st.just(FOREST), st.just(DOUBLE_Y)), st.integers(0, 2**31 - 1))
+def test_the_level_by_level_walk_equals_the_joint_by_joint_walk(arm, seed):
+    """tree_frames turns all joints of one depth at once; listed order, roots and depths mixed
+    (FOREST: two roots, a joint listed after deeper ones) give the same frames."""
+    theta = np.random.default_rng(seed).uniform(-np.pi, np.pi, arm.n_joints)
+    for ours, plain in zip(ik.tree_frames(arm, theta), walk_joint_by_joint(arm, theta)):
+        np.testing.assert_allclose(ours, plain, atol=1e-12)
+
+
+def test_depth_levels_put_every_parent_one_level_up():
+    levels = depth_levels(FOREST.parents)
+    assert [lv.tolist() for lv in levels] == [[0, 2], [1, 4, 6], [3, 5]]
 
 
 @pytest.mark.parametrize("arm", [Y, DOUBLE_Y], ids=["Y", "double Y"])
