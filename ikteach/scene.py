@@ -51,8 +51,32 @@ def triad(T, size):
                       tip_radius=0.1, shaft_radius=0.035), TRIAD_COLORS[k]) for k in range(3)]
 
 
+def triad_anchors(T):
+    """(origin, unit direction) of each arrow of triad(T)."""
+    T = np.asarray(T, dtype=float)
+    return [(T[:3, 3], T[:3, k]) for k in range(3)]
+
+
+UP_Z = np.array([0.0, 0.0, 1.0])
+
+
+def arm_anchors(positions, axes):
+    """(origin, unit direction) of each part of arm_meshes, in its order: the base, a tube per
+    link of non-zero length (from its first joint towards the next), a cylinder per joint (along
+    its axis) and the end-effector sphere. Each part is symmetric about its direction, so a
+    part at one pose moves to another by the rigid motion of its anchor."""
+    anchors = [(positions[0], UP_Z)]
+    for a, b in zip(positions[:-1], positions[1:]):
+        length = np.linalg.norm(b - a)
+        if length > 1e-9:
+            anchors.append((a, (b - a) / length))
+    anchors += [(p, w / np.linalg.norm(w)) for p, w in zip(positions[:-1], axes)]
+    return anchors + [(positions[-1], UP_Z)]
+
+
 def arm_meshes(arm, theta, scale=None):
-    """The arm as meshes: [(mesh, colour), ...] with link tubes, joint cylinders and the base."""
+    """The arm as meshes: [(mesh, colour), ...] with link tubes, joint cylinders and the base,
+    in the order of arm_anchors."""
     pv = _pv()
     scale = float(reach(arm)) if scale is None else scale
     positions, axes, _ = frames(arm, theta)
@@ -81,13 +105,57 @@ def trail_mesh(points, scale):
 
 def add_meshes(plotter, parts, **style):
     """Add [(mesh, colour), ...] as one actor per colour, the parts of a colour merged into one
-    mesh (they stay separate pieces): a few actors to build and draw instead of one per part."""
+    mesh (they stay separate pieces): a few actors to build and draw instead of one per part.
+    Returns [(merged mesh, indices of its parts), ...]."""
     by_colour = {}
-    for mesh, colour in parts:
-        by_colour.setdefault(colour, []).append(mesh)
-    for colour, meshes in by_colour.items():
-        merged = meshes[0].append_polydata(*meshes[1:]) if len(meshes) > 1 else meshes[0]
+    for i, (_, colour) in enumerate(parts):
+        by_colour.setdefault(colour, []).append(i)
+    groups = []
+    for colour, members in by_colour.items():
+        meshes = [parts[i][0] for i in members]
+        merged = meshes[0].append_polydata(*meshes[1:]) if len(meshes) > 1 else meshes[0].copy()
         plotter.add_mesh(merged, color=colour, render=False, **style)
+        groups.append((merged, members))
+    return groups
+
+
+def turn_onto(a, b):
+    """The smallest rotation taking unit vector a onto unit vector b (3 x 3)."""
+    v, c = np.cross(a, b), float(np.dot(a, b))
+    if c < -1.0 + 1e-12:  # opposite: half a turn about any axis perpendicular to a
+        w = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
+        w /= np.linalg.norm(w)
+        return 2.0 * np.outer(w, w) - np.eye(3)
+    K = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+    return np.eye(3) + K + K @ K / (1.0 + c)
+
+
+class MovingParts:
+    """Parts added with add_meshes that then move rigidly with their anchors: a new pose moves
+    the points already drawn instead of building every mesh again (solve_gif's frames)."""
+
+    def __init__(self, plotter, parts, anchors, **style):
+        self.anchors = [(np.asarray(o, float), np.asarray(d, float)) for o, d in anchors]
+        self.groups = []
+        for merged, members in add_meshes(plotter, parts, **style):
+            sizes = [parts[i][0].n_points for i in members]
+            owner = np.repeat(members, sizes)  # the part each merged point belongs to
+            normals = merged.point_data.get("Normals")
+            self.groups.append((merged, owner, np.array(merged.points),
+                                None if normals is None else np.array(normals)))
+
+    def move(self, anchors):
+        """Move every part from its first anchor to the new one: p -> R (p - o) + o'."""
+        turns, shifts = [], []
+        for (o, d), (o_new, d_new) in zip(self.anchors, anchors):
+            R = turn_onto(d, np.asarray(d_new, float))
+            turns.append(R)
+            shifts.append(np.asarray(o_new, float) - R @ o)
+        turns, shifts = np.stack(turns), np.stack(shifts)
+        for merged, owner, points, normals in self.groups:
+            merged.points = np.einsum("nab,nb->na", turns[owner], points) + shifts[owner]
+            if normals is not None:
+                merged.point_data["Normals"] = np.einsum("nab,nb->na", turns[owner], normals)
 
 
 def _camera(arm, scale):
@@ -105,6 +173,12 @@ def scene(arm, theta, target=None, trail=None, window_size=WINDOW, ghost=None, p
     ghost   another theta (e.g. the start), drawn translucent.
     The end effector's frame is drawn as a triad; the camera is fixed, so renders repeat.
     """
+    p, _ = _scene(arm, theta, target, trail, window_size, ghost, plotter)
+    return p
+
+
+def _scene(arm, theta, target, trail, window_size, ghost, plotter):
+    """scene(), and the arm with its end triad as MovingParts."""
     pv = _pv()
     scale = float(reach(arm))
     p = plotter if plotter is not None else pv.Plotter(window_size=list(window_size),
@@ -115,9 +189,7 @@ def scene(arm, theta, target=None, trail=None, window_size=WINDOW, ghost=None, p
     p.add_mesh(floor, color="#f2f2f2", ambient=0.6, diffuse=0.4, render=False)
     if ghost is not None:
         add_meshes(p, arm_meshes(arm, ghost, scale), opacity=0.25)
-    add_meshes(p, arm_meshes(arm, theta, scale), smooth_shading=True)
-    _, _, T = frames(arm, theta)
-    add_meshes(p, triad(T, 0.2 * scale))
+    pose = _posed_arm(p, arm, theta, scale)
     if target is not None:
         target = np.asarray(target, dtype=float)
         if target.shape == (4, 4):
@@ -127,18 +199,42 @@ def scene(arm, theta, target=None, trail=None, window_size=WINDOW, ghost=None, p
             centre = np.append(target, 0.0)[:3] if target.shape == (2,) else target
         p.add_mesh(pv.Sphere(center=centre, radius=0.025 * scale), color=COLORS["target"], opacity=0.6,
                    render=False)
-    if trail is not None:
-        mesh = trail_mesh(trail, scale)
-        if mesh is not None:
-            p.add_mesh(mesh, color=COLORS["trail"], render=False)
+    _draw_trail(p, trail, scale)
     p.camera_position = _camera(arm, scale)
     p.camera.view_angle = 24.0
     p._ikteach_alt = describe(arm, theta, target=target, trail=trail, ghost=ghost)
-    return p
+    return p, pose
+
+
+def _posed_arm(plotter, arm, theta, scale):
+    """The arm (smooth shaded) and its end triad, as MovingParts; pose_anchors(theta) moves them."""
+    positions, axes, T = frames(arm, theta)
+    arm_parts = MovingParts(plotter, arm_meshes(arm, theta, scale), arm_anchors(positions, axes),
+                            smooth_shading=True)
+    end_triad = MovingParts(plotter, triad(T, 0.2 * scale), triad_anchors(T))
+    return arm_parts, end_triad
+
+
+def _move_arm(pose, arm, theta):
+    arm_parts, end_triad = pose
+    positions, axes, T = frames(arm, theta)
+    arm_parts.move(arm_anchors(positions, axes))
+    end_triad.move(triad_anchors(T))
+
+
+def _draw_trail(plotter, trail, scale):
+    """The trail as the actor named "trail" (replacing the last one); none for < 2 points."""
+    mesh = trail_mesh(trail, scale) if trail is not None else None
+    if mesh is not None:
+        plotter.add_mesh(mesh, color=COLORS["trail"], render=False, name="trail")
+    else:
+        plotter.remove_actor("trail", render=False)
 
 
 def render(plotter):
-    """Render off screen to an (h, w, 3) uint8 image; the plotter stays usable."""
+    """Render off screen to an (h, w, 3) uint8 image; the plotter stays usable (a plotter
+    changed since its last render is rendered again: screenshot alone would not)."""
+    plotter.render()  # nothing before the first render, which screenshot makes
     return np.asarray(plotter.screenshot(return_img=True))
 
 
@@ -190,16 +286,20 @@ def describe(arm, theta, target=None, trail=None, ghost=None):
 
 def solve_gif(arm, trace_theta, path, target=None, frames_max=30, fps=8, window_size=(320, 240)):
     """Write a GIF of a solve: one frame per iterate of trace_theta (subsampled to at most
-    frames_max), the end effector's path so far drawn as a trail. Returns the path."""
+    frames_max), the end effector's path so far drawn as a trail. Returns the path.
+    The scene is built once; each frame moves the arm's meshes and redraws the trail
+    (12 frames of the iiwa: 0.85 -> 0.4 s)."""
     pv = _pv()
     thetas = np.asarray(trace_theta, dtype=float)
     idx = np.unique(np.linspace(0, len(thetas) - 1, min(frames_max, len(thetas))).round().astype(int))
     ends = end_path(arm, thetas)
+    scale = float(reach(arm))
     p = pv.Plotter(window_size=list(window_size), off_screen=True)
     p.open_gif(str(path), fps=fps)
+    _, pose = _scene(arm, thetas[idx[0]], target, ends[: idx[0] + 1], window_size, None, p)
     for k in idx:
-        p.clear()
-        scene(arm, thetas[k], target=target, trail=ends[: k + 1], plotter=p)
+        _move_arm(pose, arm, thetas[k])
+        _draw_trail(p, ends[: k + 1], scale)
         p.write_frame()
     p.close()
     return path

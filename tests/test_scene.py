@@ -52,6 +52,35 @@ def test_arm_meshes_sit_on_the_joints():
     np.testing.assert_allclose(T[:3, 3], np.asarray(ik.fk(arm, theta)), atol=1e-12)
 
 
+def test_a_moved_scene_looks_like_one_built_at_the_new_pose(reference):
+    """solve_gif builds its scene once and moves the arm's meshes rigidly from frame to frame:
+    moved from another pose, the scene renders as one built at SCENE_THETA does."""
+    import pyvista as pv
+
+    pv.OFF_SCREEN = True
+    arm = ik.ur5()
+    target = np.asarray(ik.fk_pose(arm, SCENE_THETA + 0.25))
+    p, pose = scene._scene(arm, SCENE_THETA - 0.4, target, None, scene.WINDOW, None, None)
+    assert ssim(reference, scene.render(p), crop_to=reference) < SCENE_SSIM  # not there yet
+    scene._move_arm(pose, arm, SCENE_THETA)
+    moved = scene.render(p)
+    p.close()
+    assert ssim(reference, moved, crop_to=reference) > SCENE_SSIM
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_turn_onto_takes_one_direction_onto_another(seed):
+    rng = np.random.default_rng(seed)
+    a = rng.normal(size=3)
+    a /= np.linalg.norm(a)
+    for b in (rng.normal(size=3), -a, a):
+        b = b / np.linalg.norm(b)
+        R = scene.turn_onto(a, b)
+        np.testing.assert_allclose(R @ a, b, atol=1e-12)
+        np.testing.assert_allclose(R.T @ R, np.eye(3), atol=1e-12)
+        assert np.linalg.det(R) == pytest.approx(1.0)
+
+
 def test_solve_gif_writes_frames(tmp_path, monkeypatch):
     import pyvista as pv
 
