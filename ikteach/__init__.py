@@ -13,6 +13,10 @@ from . import host_devices
 jax.config.update("jax_enable_x64", True)
 host_devices.request(jax)  # one CPU device per core, for solve_batch (before JAX starts)
 
+from . import lapack_tables  # noqa: E402
+
+lapack_tables.preload()  # the first SVD or solve lowers without importing scipy.linalg (0.2 s)
+
 from .chain import Chain, planar_chain, serial_chain, reach  # noqa: E402
 from .kinematics import fk, joint_positions, joint_frames, rotation_about  # noqa: E402
 from .jacobian import jacobian, jacobian_autodiff, jacobian_fd  # noqa: E402

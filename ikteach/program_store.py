@@ -40,6 +40,8 @@ import warnings
 import jax
 import numpy as np
 
+from . import lapack_tables
+
 FORMAT = "ikteach-program-4"
 SUBFOLDER = "programs"
 STORE_ENV = "IKTEACH_PROGRAM_STORE"  # "off": JAX's persistent cache only
@@ -354,7 +356,7 @@ def lapack_ready():
     global _lapack_ready
     if _lapack_ready is None:
         _lapack_ready = False
-        _load_scipy_lapack_tables()
+        lapack_tables.preload()
         try:
             from jax._src.lax import linalg
 
@@ -369,29 +371,6 @@ def lapack_ready():
             except Exception:
                 pass
     return _lapack_ready
-
-
-def _load_scipy_lapack_tables():
-    """jaxlib reads its LAPACK pointers from scipy.linalg.cython_blas and .cython_lapack.
-    Importing those the usual way imports all of scipy.linalg first (0.25 s); loaded straight
-    from their files they take 0.02 s. Where scipy is laid out otherwise, nothing is done and
-    jaxlib imports them itself."""
-    import importlib.util
-
-    try:
-        spec = importlib.util.find_spec("scipy")
-        folder = pathlib.Path(spec.submodule_search_locations[0]) / "linalg"
-        for name in ("cython_blas", "cython_lapack"):
-            full = f"scipy.linalg.{name}"
-            if full in sys.modules:
-                continue
-            files = sorted(folder.glob(f"{name}.*.so")) + sorted(folder.glob(f"{name}.*.pyd"))
-            module_spec = importlib.util.spec_from_file_location(full, files[0])
-            module = importlib.util.module_from_spec(module_spec)
-            module_spec.loader.exec_module(module)
-            sys.modules[full] = module
-    except Exception:
-        pass
 
 
 def _load(path, in_tree):
@@ -498,7 +477,7 @@ def store_works():
 
 def calls_lapack(compiled):
     """Does the program call jaxlib's LAPACK kernels (SVD, solves)? Those need lapack_ready()
-    before it runs (0.02 s, see _load_scipy_lapack_tables): loads of other programs skip it."""
+    before it runs (0.02 s with lapack_tables.preload): loads of other programs skip it."""
     try:
         return 'custom_call_target="lapack_' in compiled.as_text()
     except Exception:

@@ -61,7 +61,7 @@ def test_a_second_process_loads_every_program_and_gets_the_same_bits(tmp_path):
     first_counts, first = run_script(tmp_path)
     second_counts, second = run_script(tmp_path)
     assert first_counts.get("compiled", 0) >= 6 and first_counts.get("loaded", 0) == 0
-    assert first_counts["scipy.linalg imported"]  # lowering a linear solve imports it
+    assert not first_counts["scipy.linalg imported"]  # see test_lapack_tables
     assert second_counts == {"loaded": first_counts["compiled"],  # no tracing, no compiling
                              "scipy.linalg imported": False}
     assert second == first
