@@ -334,14 +334,25 @@ def still_png(anim, frame=None):
 
 
 def frame_pngs(anim):
-    """PNG bytes of every frame of an animation made here, drawing what stays still once.
+    """PNG bytes of every frame of an animation made here (see frame_images)."""
+    from PIL import Image
+
+    pngs = []
+    for image in frame_images(anim):
+        buf = io.BytesIO()
+        Image.fromarray(image).save(buf, format="png")
+        pngs.append(buf.getvalue())
+    return pngs
+
+
+def frame_images(anim):
+    """Every frame of an animation made here as an RGBA array, drawing what stays still once.
 
     The figure is drawn once without the artists a frame changes (the arm, trail, titles...);
     each frame restores that background and draws only those artists on it, as blitting does
     on screen. A full redraw spent most of its time on unchanging axes, ticks and legends.
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from PIL import Image
 
     anim._init_draw()  # counts as drawn: no "deleted without rendering" warning
     fig = anim._fig
@@ -352,23 +363,21 @@ def frame_pngs(anim):
     try:
         canvas.draw()
         background = canvas.copy_from_bbox(fig.bbox)
-        pngs = []
+        images = []
         for j in range(len(anim.iterations)):
             drawn = _in_draw_order(fig, anim.draw_frame(j))
             canvas.restore_region(background)
             for artist in drawn:
                 fig.draw_artist(artist)
-            buf = io.BytesIO()
-            Image.fromarray(np.asarray(canvas.buffer_rgba())).save(buf, format="png")
-            pngs.append(buf.getvalue())
+            images.append(np.array(canvas.buffer_rgba()))
     finally:
         for artist in moving:
             artist.set_animated(False)
-    return pngs
+    return images
 
 
 def save_gif(anim, path, fps=5, dpi=None):
-    """Write an animation made here as a looping GIF, its frames from frame_pngs (what stays
+    """Write an animation made here as a looping GIF, its frames from frame_images (what stays
     still drawn once), like anim.save(path, writer="pillow", fps=fps, dpi=dpi)."""
     from PIL import Image
 
@@ -377,7 +386,7 @@ def save_gif(anim, path, fps=5, dpi=None):
     if dpi is not None:
         fig.set_dpi(dpi)
     try:
-        frames = [Image.open(io.BytesIO(png)).convert("RGBA") for png in frame_pngs(anim)]
+        frames = [Image.fromarray(image) for image in frame_images(anim)]
     finally:
         fig.set_dpi(old_dpi)
     frames[0].save(path, save_all=True, append_images=frames[1:], duration=int(1000 / fps),
