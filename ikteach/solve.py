@@ -25,8 +25,8 @@ from .dls import dls_step
 from .fabrik import FABRIKMethod
 from .sdls import GAMMA_MAX, SDLSMethod
 from .jt import jt_step
-from .levels import DEFAULT_REST_GAIN, with_priorities
-from .joint_limits import with_limits
+from .levels import DEFAULT_REST_GAIN, PriorityMethod, with_priorities
+from .joint_limits import LimitedMethod, with_limits
 from .limits import cap_step, clamp_error
 from .pinv import DEFAULT_RCOND, pinv_step, pinv_two_rows
 from .tasks import task_for
@@ -240,7 +240,7 @@ def traceable(method, task, arm, target, theta0, settings):
 
     Built-in methods are JAX code; a user's step is tried once per problem shape.
     """
-    if method in METHODS.values():
+    if built_in(method):
         return True
     key = (method, task, type(arm), arm.dim, target.shape, theta0.shape)
     if key not in _TRACEABLE:
@@ -251,6 +251,14 @@ def traceable(method, task, arm, target, theta0, settings):
         except Exception:
             _TRACEABLE[key] = False
     return _TRACEABLE[key]
+
+
+def built_in(method):
+    """Is the method ikteach's own JAX code: a built-in method, the priority step, or one of
+    those within joint limits? (Only a user's step function needs trying.)"""
+    if isinstance(method, LimitedMethod):
+        return built_in(method.inner)
+    return method in METHODS.values() or isinstance(method, PriorityMethod)
 
 
 def resolve_method(method):
