@@ -292,6 +292,8 @@ class StoredProgram:
         static = tuple((k, v) for k, v in values.items() if k in self._static)
         dynamic = tuple(v for k, v in values.items() if k not in self._static)
         leaves, treedef = jax.tree_util.tree_flatten(dynamic)
+        if any(isinstance(leaf, jax.core.Tracer) for leaf in leaves):
+            return self._jitted(*args, **kwargs)  # called while tracing another program
         signature = tuple(map(_leaf_signature, leaves))
         if None in signature:
             counts["plain"] += 1

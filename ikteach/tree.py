@@ -9,11 +9,13 @@ A tree of n revolute joints and m end effectors is stored in its rest pose (thet
 Turning joint j turns everything below it about the line through p_j along z_j.
 """
 import dataclasses
+from functools import partial
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
+from . import xla
 from ._validate import as_array
 from .kinematics import rotation_about
 
@@ -103,7 +105,7 @@ def depth_levels(parents):
     return [np.flatnonzero(depth == d) for d in range(depth.max() + 1)]
 
 
-@jax.jit
+@partial(xla.jit, fast_compile=False)  # kept on disk: tracing a big tree takes 0.1-0.2 s
 def tree_frames(arm, theta):
     """World joint positions (n, 3), world axes (n, 3) and effector positions (m, 3).
 
@@ -139,7 +141,7 @@ def tree_frames(arm, theta):
     return p, z, x
 
 
-@jax.jit
+@partial(xla.jit, fast_compile=False)
 def tree_fk(arm, theta):
     """End-effector positions x_k = F_k(theta): shape (m, 3)."""
     return tree_frames(arm, theta)[2]
@@ -161,7 +163,7 @@ def tree_jacobian_from_frames(arm, p, z, x):
     return jnp.transpose(blocks, (0, 2, 1)).reshape(3 * arm.n_effectors, arm.n_joints)
 
 
-@jax.jit
+@partial(xla.jit, fast_compile=False)
 def tree_jacobian_autodiff(arm, theta):
     """The stacked Jacobian by jax.jacfwd of the flattened effector positions, for checking."""
     return jax.jacfwd(lambda t: tree_fk(arm, t).reshape(-1))(jnp.asarray(theta, dtype=float))

@@ -41,13 +41,15 @@ def _chosen():
 COMPILER_OPTIONS = _chosen()
 
 
-def jit(fun=None, **kwargs):
+def jit(fun=None, fast_compile=True, **kwargs):
     """jax.jit(fun, **kwargs) with COMPILER_OPTIONS; as a decorator, with or without arguments
     (`@jit`, `@partial(jit, static_argnames=...)`). Its executables are also kept whole in the
-    program store when compilation_cache() opened one (ikteach/program_store.py)."""
+    program store when compilation_cache() opened one (ikteach/program_store.py).
+    fast_compile=False leaves out COMPILER_OPTIONS: compiled exactly as jax.jit does, for
+    functions whose results must stay equal to the bit to what they were (still stored)."""
     if fun is None:
-        return functools.partial(jit, **kwargs)
-    if COMPILER_OPTIONS:
+        return functools.partial(jit, fast_compile=fast_compile, **kwargs)
+    if COMPILER_OPTIONS and fast_compile:
         kwargs.setdefault("compiler_options", COMPILER_OPTIONS)
     jitted = jax.jit(fun, **kwargs)
     if "static_argnums" in kwargs:

@@ -208,6 +208,30 @@ def test_a_patched_module_turns_the_store_off(store, monkeypatch):
     assert store.counts == {"plain": 1}
 
 
+def test_a_stored_function_called_while_tracing_is_traced_into_the_caller(store):
+    program = xla.jit(square_sum, fast_compile=False, static_argnames=("power",))
+    caller = jax.jit(lambda x: program(x, 2.0, power=2) + 1.0)
+    assert float(caller(jnp.arange(3.0))) == 11.0
+    assert float(jax.grad(lambda x: program(x, 1.0, power=2))(3.0)) == 6.0
+    assert store.counts == {} and not list(store._root.glob("*.bin"))
+
+
+def test_exact_programs_are_compiled_as_jax_jit_does(store):
+    """fast_compile=False: no compiler options (JAX refuses those on a nested call, so the
+    nested call shows them), and results equal plain jax.jit's to the bit."""
+    fast = xla.jit(square_sum, static_argnames=("power",))
+    exact = xla.jit(square_sum, fast_compile=False, static_argnames=("power",))
+    if xla.COMPILER_OPTIONS:
+        with pytest.raises(ValueError, match="compiler_options"):
+            jax.jit(lambda x: fast(x, 1.0, power=2))(jnp.arange(3.0))
+    assert float(jax.jit(lambda x: exact(x, 1.0, power=2))(jnp.arange(3.0))) == 5.0
+    arm, theta = ik.buss_trees.double_y_tree(), np.linspace(-1.0, 1.0, 25)
+    function = ik.tree_jacobian_autodiff.__wrapped__
+    ours = np.asarray(xla.jit(function, fast_compile=False)(arm, theta))
+    plain = np.asarray(jax.jit(function)(arm, theta))
+    assert store.counts == {"compiled": 1} and ours.tobytes() == plain.tobytes()
+
+
 def test_a_committed_array_goes_to_plain_jit(store):
     program = xla.jit(square_sum, static_argnames=("power",))
     x = jax.device_put(jnp.arange(3.0), jax.devices()[0])
