@@ -42,10 +42,11 @@ import numpy as np
 
 from . import lapack_tables
 
-FORMAT = "ikteach-program-4"
+FORMAT = "ikteach-program-5"
 SUBFOLDER = "programs"
 STORE_ENV = "IKTEACH_PROGRAM_STORE"  # "off": JAX's persistent cache only
 STALE_DAYS = 14  # env folders (other versions, other source) untouched this long are removed
+AHEAD = 4  # programs read ahead in the background: the ones that followed last time
 
 # Modules a function in an ikteach module's globals may come from; anything else (__main__,
 # a student's file) means the module was patched and stored programs may not match it.
@@ -78,6 +79,12 @@ _lapack_ready = None
 # What the store did this session: programs "loaded" from disk, "compiled" (and written),
 # calls left to "plain" jax.jit because the key was not certain.
 counts = collections.Counter()
+# Read-ahead: "ready" (loaded in the background before it was asked for), "waited" (asked
+# for while still loading), "unused" (read ahead, then asked for with other arguments).
+ahead_counts = collections.Counter()
+_previous = None  # the key of the program this process asked for last
+_ahead = {}  # key -> Future of a program read ahead
+_reader = None  # the background thread's executor
 
 
 def open_store(cache_dir):
@@ -329,7 +336,8 @@ class StoredProgram:
         key = hashlib.sha256("\n".join(described + [repr(signature)]).encode()).hexdigest()
         path = _root / f"{key}.bin"
         in_tree = jax.tree_util.tree_structure((dynamic, {}))
-        program, out = _load(path, in_tree), None
+        program, out = _read_ahead_or_load(key, path, in_tree), None
+        _follow(key)
         if program is not None:
             counts["loaded"] += 1
         else:
@@ -342,10 +350,10 @@ class StoredProgram:
 
 
 class _Loaded:
-    """A Compiled with the file it came from (deleted should it fail)."""
+    """A Compiled with the file it came from (deleted should it fail) and its input tree."""
 
-    def __init__(self, compiled, store_path):
-        self.compiled, self.store_path = compiled, store_path
+    def __init__(self, compiled, store_path, in_tree=None):
+        self.compiled, self.store_path, self.in_tree = compiled, store_path, in_tree
 
     def __call__(self, *args):
         return self.compiled(*args)
@@ -375,7 +383,8 @@ def lapack_ready():
     return _lapack_ready
 
 
-def _load(path, in_tree):
+def _load(path, in_tree=None):
+    """The program in a store file, for arguments of structure in_tree (None: the file's)."""
     from jax.experimental import serialize_executable
 
     try:
@@ -383,16 +392,67 @@ def _load(path, in_tree):
     except OSError:
         return None
     try:
-        serialized, out_tree, device_ids, needs_lapack = pickle.loads(blob)
+        serialized, file_tree, out_tree, device_ids, needs_lapack = pickle.loads(blob)
+        if in_tree is not None and in_tree != file_tree:
+            raise ValueError("another program's file")
         if needs_lapack and not lapack_ready():
             return None
         by_id = {d.id: d for d in jax.devices()}
         compiled = serialize_executable.deserialize_and_load(
-            serialized, in_tree, out_tree, execution_devices=[by_id[i] for i in device_ids])
-        return _Loaded(compiled, path)
+            serialized, file_tree, out_tree, execution_devices=[by_id[i] for i in device_ids])
+        return _Loaded(compiled, path, file_tree)
     except Exception:  # a truncated or foreign file: compile again
         _unlink(path)
         return None
+
+
+def _read_ahead_or_load(key, path, in_tree):
+    """The program, from the background reader if it was read ahead, else from its file."""
+    future = _ahead.pop(key, None)
+    if future is not None:
+        ahead_counts["ready" if future.done() else "waited"] += 1
+        try:
+            program = future.result()
+        except Exception:
+            program = None
+        if program is not None and program.in_tree == in_tree:
+            return program
+        ahead_counts["unused"] += 1
+    return _load(path, in_tree)
+
+
+def _follow(key):
+    """Note that key came after the previous program asked for (in <previous>.next), then
+    read ahead, in a background thread, the programs that followed key last time: a notebook
+    run again asks for the same programs in the same order, and loading one (20-80 ms, most
+    of it outside Python's lock) then overlaps the cells before it is needed."""
+    global _previous
+    previous, _previous = _previous, key
+    try:
+        if previous is not None and previous != key:
+            marker = _root / f"{previous}.next"
+            if not marker.exists() or marker.read_text() != key:
+                _write(marker, key.encode())
+        following = key
+        for _ in range(AHEAD):
+            marker = _root / f"{following}.next"
+            if _broken or not marker.exists():
+                break
+            following = marker.read_text().strip()
+            if following == key or following in _ahead or not following.isalnum():
+                continue
+            _ahead[following] = _background().submit(_load, _root / f"{following}.bin")
+    except OSError:
+        pass
+
+
+def _background():
+    global _reader
+    if _reader is None:
+        import concurrent.futures
+
+        _reader = concurrent.futures.ThreadPoolExecutor(1, thread_name_prefix="ikteach-read-ahead")
+    return _reader
 
 
 def _compile_and_save(jitted, positional, dynamic, in_tree, path):
@@ -416,7 +476,7 @@ def _compile_and_save(jitted, positional, dynamic, in_tree, path):
             _write(path, blob)
     except Exception:
         pass  # not serializable here, or the folder is read-only: run it all the same
-    return _Loaded(compiled, path), out
+    return _Loaded(compiled, path, in_tree), out
 
 
 def _checked_bytes(compiled, in_tree, args, out):
@@ -433,7 +493,7 @@ def _checked_bytes(compiled, in_tree, args, out):
                                                      execution_devices=devices)
     if not same_bits(out, jax.block_until_ready(copy(*args))):
         return None
-    return pickle.dumps((serialized, out_tree, [d.id for d in devices], needs_lapack),
+    return pickle.dumps((serialized, in_tree, out_tree, [d.id for d in devices], needs_lapack),
                         protocol=pickle.HIGHEST_PROTOCOL)
 
 

@@ -37,6 +37,7 @@ for side in (12, 33):  # 1089 targets: split over the CPU devices where there ar
 t = ik.track(planar, np.linspace([1.5, 0.2], [0.3, 1.4], 30), [0.3, 0.2, 0.1])
 out["track"] = hexes(t.theta)
 out["counts"] = dict(program_store.counts)
+out["ahead"] = dict(program_store.ahead_counts)
 import sys
 out["scipy.linalg"] = "scipy.linalg" in sys.modules  # a load needs only its LAPACK tables
 import scipy.linalg  # and scipy.linalg imports as usual after them
@@ -52,6 +53,7 @@ def run_script(cache, store="on"):
     assert done.returncode == 0, done.stderr[-3000:]
     out = json.loads(done.stdout.splitlines()[-1])
     out["counts"]["scipy.linalg imported"] = out.pop("scipy.linalg")
+    out["counts"]["read ahead"] = out.pop("ahead")
     return out.pop("counts"), out
 
 
@@ -62,8 +64,13 @@ def test_a_second_process_loads_every_program_and_gets_the_same_bits(tmp_path):
     second_counts, second = run_script(tmp_path)
     assert first_counts.get("compiled", 0) >= 6 and first_counts.get("loaded", 0) == 0
     assert not first_counts["scipy.linalg imported"]  # see test_lapack_tables
+    assert first_counts["read ahead"] == {}  # nothing to go on yet
+    ahead = second_counts.pop("read ahead")
     assert second_counts == {"loaded": first_counts["compiled"],  # no tracing, no compiling
                              "scipy.linalg imported": False}
+    # every program after the first was read ahead, in the order the first process used them
+    assert ahead.get("ready", 0) + ahead.get("waited", 0) == first_counts["compiled"] - 1
+    assert "unused" not in ahead
     assert second == first
     assert first["dls pose"][0] == "converged" and first["jt"][0] == "converged"
 
@@ -124,6 +131,9 @@ def store(tmp_path, monkeypatch):
     monkeypatch.setattr(program_store, "_root", None)
     monkeypatch.setattr(program_store, "_broken", False)
     monkeypatch.setattr(program_store, "counts", program_store.collections.Counter())
+    monkeypatch.setattr(program_store, "ahead_counts", program_store.collections.Counter())
+    monkeypatch.setattr(program_store, "_previous", None)
+    monkeypatch.setattr(program_store, "_ahead", {})
     assert program_store.open_store(tmp_path) is not None
     return program_store
 
@@ -230,6 +240,40 @@ def test_exact_programs_are_compiled_as_jax_jit_does(store):
     ours = np.asarray(xla.jit(function, fast_compile=False)(arm, theta))
     plain = np.asarray(jax.jit(function)(arm, theta))
     assert store.counts == {"compiled": 1} and ours.tobytes() == plain.tobytes()
+
+
+def test_programs_are_read_ahead_in_the_order_they_were_used(store):
+    """The store notes which program followed which; in a new process, asking for one starts
+    loading those that followed it last time, and a changed order is noted again."""
+    program = xla.jit(square_sum, static_argnames=("power",))
+    sizes = [3, 4, 5, 6]
+    for n in sizes:
+        program(jnp.arange(float(n)), 1.0, power=2)
+    assert len(list(store._root.glob("*.next"))) == 3
+    program._loaded.clear()  # as in a new process
+    store._previous = None
+    assert float(program(jnp.arange(3.0), 1.0, power=2)) == 5.0
+    assert len(store._ahead) == 3  # 4, 5 and 6 are loading
+    for n in sizes[1:]:
+        assert float(program(jnp.arange(float(n)), 1.0, power=2)) == sum(k * k for k in range(n))
+    assert store.ahead_counts["ready"] + store.ahead_counts["waited"] == 3
+    assert store.counts["loaded"] == 4 and not store._ahead
+
+
+def test_a_program_read_ahead_for_other_arguments_is_not_used(store):
+    program = xla.jit(square_sum, static_argnames=("power",))
+    program(jnp.arange(3.0), 1.0, power=2)
+    program(jnp.arange(4.0), 1.0, power=2)
+    (first,) = [p for p in store._root.glob("*.next")]
+    second = store._root / (first.read_text() + ".bin")
+    other = program_store.pickle.loads(second.read_bytes())
+    foreign = (other[0], jax.tree_util.tree_structure(((1.0,), {})), *other[2:])
+    second.write_bytes(program_store.pickle.dumps(foreign))  # claims another input structure
+    program._loaded.clear()
+    store._previous = None
+    program(jnp.arange(3.0), 1.0, power=2)
+    assert float(program(jnp.arange(4.0), 1.0, power=2)) == 14.0
+    assert store.ahead_counts["unused"] == 1 and store.counts["compiled"] == 3
 
 
 def test_a_committed_array_goes_to_plain_jit(store):
