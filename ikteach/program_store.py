@@ -456,11 +456,12 @@ def _background():
 
 
 def _compile_and_save(jitted, positional, dynamic, in_tree, path):
-    """Compile (without JAX's persistent cache), run, and write the store's file only when a
-    copy read back from those bytes gives the same output to the bit. An executable that JAX
-    took from its own cache, or from this process's memory of one (a plain jit call of the
-    same program), serializes into bytes that load but do not run ("Function ... not
-    found"): the check keeps those out.
+    """Compile (without JAX's persistent cache), run, and have the background thread write
+    the store's file, only once a copy read back from its bytes gives the same output to the
+    bit. An executable that JAX took from its own cache, or from this process's memory of one
+    (a plain jit call of the same program), serializes into bytes that load but do not run
+    ("Function ... not found"): the check keeps those out. Checked in the background, it
+    costs the caller only the serializing (a cold notebook compiles 20-30 programs).
     Returns (the compiled program, its output), or (None, None) to leave it to jax.jit."""
     if not store_works():
         return None, None  # plain jit, through JAX's cache
@@ -471,17 +472,37 @@ def _compile_and_save(jitted, positional, dynamic, in_tree, path):
     except Exception:
         return None, None  # jit raises it again, with its own message
     try:
-        blob = _checked_bytes(compiled, in_tree, dynamic, out)
-        if blob is not None:
-            _write(path, blob)
+        parts = _serialized(compiled)
+        if parts is not None:
+            inputs = jax.tree_util.tree_map(_frozen, dynamic)  # the caller may change its arrays
+            _background().submit(_check_and_write, parts, in_tree, inputs, out, path)
     except Exception:
-        pass  # not serializable here, or the folder is read-only: run it all the same
+        pass  # not serializable here: run it all the same
     return _Loaded(compiled, path, in_tree), out
 
 
-def _checked_bytes(compiled, in_tree, args, out):
-    """The store's file for a compiled program that gave `out` on `args`, or None when a copy
-    read back from its bytes does not give the same output to the bit."""
+def _frozen(leaf):
+    return np.array(leaf) if isinstance(leaf, np.ndarray) else leaf
+
+
+def _check_and_write(parts, in_tree, args, out, path):
+    try:
+        blob = _checked_bytes(parts, in_tree, args, out)
+        if blob is not None:
+            _write(path, blob)
+    except Exception:
+        pass  # the folder is read-only, or the copy failed: no file
+
+
+def finish_writing():
+    """Wait until the background thread has written every program compiled so far."""
+    if _reader is not None:
+        _reader.submit(lambda: None).result()
+
+
+def _serialized(compiled):
+    """(bytes, out_tree, devices in order, calls LAPACK) for a compiled program; None where its
+    LAPACK calls cannot be set up here."""
     from jax.experimental import serialize_executable
 
     needs_lapack = calls_lapack(compiled)
@@ -489,6 +510,15 @@ def _checked_bytes(compiled, in_tree, args, out):
         return None
     serialized, _, out_tree = serialize_executable.serialize(compiled)
     devices = list(compiled._executable.xla_executable.local_devices())  # in its order
+    return serialized, out_tree, devices, needs_lapack
+
+
+def _checked_bytes(parts, in_tree, args, out):
+    """The store's file for a serialized program that gave `out` on `args`, or None when a
+    copy read back from its bytes does not give the same output to the bit."""
+    from jax.experimental import serialize_executable
+
+    serialized, out_tree, devices, needs_lapack = parts
     copy = serialize_executable.deserialize_and_load(serialized, in_tree, out_tree,
                                                      execution_devices=devices)
     if not same_bits(out, jax.block_until_ready(copy(*args))):
@@ -521,7 +551,9 @@ def _round_trip(fun, *args):
     with _without_jax_cache():
         compiled = jax.jit(fun).lower(*args).compile()
     out = jax.block_until_ready(compiled(*args))
-    return _checked_bytes(compiled, jax.tree_util.tree_structure((args, {})), args, out) is not None
+    parts = _serialized(compiled)
+    return parts is not None and _checked_bytes(parts, jax.tree_util.tree_structure((args, {})),
+                                                args, out) is not None
 
 
 def store_works():

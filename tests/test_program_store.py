@@ -149,6 +149,7 @@ def test_programs_are_kept_by_shape_and_static_value(store):
     assert float(program(jnp.arange(4.0), 1.0, power=2)) == 14.0  # new shape
     assert float(program(jnp.arange(3.0), 1.0, power=3)) == 9.0  # new static value
     assert store.counts == {"compiled": 3}
+    store.finish_writing()  # files are checked and written in the background
     assert len(list(store._root.glob("*.bin"))) == 3
     program._loaded.clear()  # as in a new process
     assert float(program(jnp.arange(3.0), 1.0, power=3)) == 9.0
@@ -158,17 +159,20 @@ def test_programs_are_kept_by_shape_and_static_value(store):
 def test_a_damaged_file_is_compiled_again(store):
     program = xla.jit(square_sum, static_argnames=("power",))
     program(jnp.arange(3.0), 2.0, power=2)
+    store.finish_writing()  # files are checked and written in the background
     (path,) = store._root.glob("*.bin")
     path.write_bytes(b"not a program")
     program._loaded.clear()
     assert float(program(jnp.arange(3.0), 2.0, power=2)) == 10.0
     assert store.counts == {"compiled": 2}
+    store.finish_writing()
     assert path.read_bytes() != b"not a program"
 
 
 def test_a_program_that_fails_to_run_falls_back_to_jit(store):
     program = xla.jit(square_sum, static_argnames=("power",))
     program(jnp.arange(3.0), 2.0, power=2)
+    store.finish_writing()  # files are checked and written in the background
     (path,) = store._root.glob("*.bin")
 
     def broken(*args):
@@ -194,6 +198,7 @@ def test_a_jax_that_cannot_read_programs_back_keeps_jit_and_its_cache(store, mon
     monkeypatch.setattr(serialize_executable, "serialize", fails)
     program = xla.jit(square_sum, static_argnames=("power",))
     assert float(program(jnp.arange(3.0), 2.0, power=2)) == 10.0
+    store.finish_writing()  # files are checked and written in the background
     assert store.counts == {"plain": 1} and not list(store._root.glob("*.bin"))
     assert program_store._works is False
 
@@ -223,6 +228,7 @@ def test_a_stored_function_called_while_tracing_is_traced_into_the_caller(store)
     caller = jax.jit(lambda x: program(x, 2.0, power=2) + 1.0)
     assert float(caller(jnp.arange(3.0))) == 11.0
     assert float(jax.grad(lambda x: program(x, 1.0, power=2))(3.0)) == 6.0
+    store.finish_writing()  # files are checked and written in the background
     assert store.counts == {} and not list(store._root.glob("*.bin"))
 
 
@@ -249,6 +255,7 @@ def test_programs_are_read_ahead_in_the_order_they_were_used(store):
     sizes = [3, 4, 5, 6]
     for n in sizes:
         program(jnp.arange(float(n)), 1.0, power=2)
+    store.finish_writing()  # files are checked and written in the background
     assert len(list(store._root.glob("*.next"))) == 3
     program._loaded.clear()  # as in a new process
     store._previous = None
@@ -264,6 +271,7 @@ def test_a_program_read_ahead_for_other_arguments_is_not_used(store):
     program = xla.jit(square_sum, static_argnames=("power",))
     program(jnp.arange(3.0), 1.0, power=2)
     program(jnp.arange(4.0), 1.0, power=2)
+    store.finish_writing()  # files are checked and written in the background
     (first,) = [p for p in store._root.glob("*.next")]
     second = store._root / (first.read_text() + ".bin")
     other = program_store.pickle.loads(second.read_bytes())
