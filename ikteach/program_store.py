@@ -20,6 +20,10 @@ machine code), and a program falls back to plain jax.jit whenever the key is not
     (a module patched from a notebook): a stored program would not see the patch.
 
 A stored program that fails to load or to run is deleted and compiled again with jax.jit.
+
+Two background threads (_background) read ahead, in the order a process last asked for them,
+the programs that follow the one just asked for (a notebook run again asks for the same
+programs in the same order), and check and write newly compiled programs.
 """
 import collections
 import contextlib
@@ -84,7 +88,8 @@ counts = collections.Counter()
 ahead_counts = collections.Counter()
 _previous = None  # the key of the program this process asked for last
 _ahead = {}  # key -> Future of a program read ahead
-_reader = None  # the background thread's executor
+_reader = None  # the background threads (reading ahead, checking and writing new programs)
+_writing = []  # futures of the files being checked and written
 
 
 def open_store(cache_dir):
@@ -423,7 +428,7 @@ def _read_ahead_or_load(key, path, in_tree):
 
 def _follow(key):
     """Note that key came after the previous program asked for (in <previous>.next), then
-    read ahead, in a background thread, the programs that followed key last time: a notebook
+    read ahead, in background threads, the programs that followed key last time: a notebook
     run again asks for the same programs in the same order, and loading one (20-80 ms, most
     of it outside Python's lock) then overlaps the cells before it is needed."""
     global _previous
@@ -451,12 +456,12 @@ def _background():
     if _reader is None:
         import concurrent.futures
 
-        _reader = concurrent.futures.ThreadPoolExecutor(1, thread_name_prefix="ikteach-read-ahead")
+        _reader = concurrent.futures.ThreadPoolExecutor(2, thread_name_prefix="ikteach-store")  # 2 cores
     return _reader
 
 
 def _compile_and_save(jitted, positional, dynamic, in_tree, path):
-    """Compile (without JAX's persistent cache), run, and have the background thread write
+    """Compile (without JAX's persistent cache), run, and have a background thread write
     the store's file, only once a copy read back from its bytes gives the same output to the
     bit. An executable that JAX took from its own cache, or from this process's memory of one
     (a plain jit call of the same program), serializes into bytes that load but do not run
@@ -475,7 +480,7 @@ def _compile_and_save(jitted, positional, dynamic, in_tree, path):
         parts = _serialized(compiled)
         if parts is not None:
             inputs = jax.tree_util.tree_map(_frozen, dynamic)  # the caller may change its arrays
-            _background().submit(_check_and_write, parts, in_tree, inputs, out, path)
+            _writing.append(_background().submit(_check_and_write, parts, in_tree, inputs, out, path))
     except Exception:
         pass  # not serializable here: run it all the same
     return _Loaded(compiled, path, in_tree), out
@@ -495,9 +500,9 @@ def _check_and_write(parts, in_tree, args, out, path):
 
 
 def finish_writing():
-    """Wait until the background thread has written every program compiled so far."""
-    if _reader is not None:
-        _reader.submit(lambda: None).result()
+    """Wait until the background threads have written every program compiled so far."""
+    while _writing:
+        _writing.pop().result()
 
 
 def _serialized(compiled):

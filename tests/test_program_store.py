@@ -134,6 +134,7 @@ def store(tmp_path, monkeypatch):
     monkeypatch.setattr(program_store, "ahead_counts", program_store.collections.Counter())
     monkeypatch.setattr(program_store, "_previous", None)
     monkeypatch.setattr(program_store, "_ahead", {})
+    monkeypatch.setattr(program_store, "_writing", [])
     assert program_store.open_store(tmp_path) is not None
     return program_store
 
