@@ -465,8 +465,8 @@ def _compile_and_save(jitted, positional, dynamic, in_tree, path):
     the store's file, only once a copy read back from its bytes gives the same output to the
     bit. An executable that JAX took from its own cache, or from this process's memory of one
     (a plain jit call of the same program), serializes into bytes that load but do not run
-    ("Function ... not found"): the check keeps those out. Checked in the background, it
-    costs the caller only the serializing (a cold notebook compiles 20-30 programs).
+    ("Function ... not found"): the check keeps those out. Serialized, checked and written
+    in the background, it costs the caller nothing (a cold notebook compiles 20-30 programs).
     Returns (the compiled program, its output), or (None, None) to leave it to jax.jit."""
     if not store_works():
         return None, None  # plain jit, through JAX's cache
@@ -477,12 +477,10 @@ def _compile_and_save(jitted, positional, dynamic, in_tree, path):
     except Exception:
         return None, None  # jit raises it again, with its own message
     try:
-        parts = _serialized(compiled)
-        if parts is not None:
-            inputs = jax.tree_util.tree_map(_frozen, dynamic)  # the caller may change its arrays
-            _writing.append(_background().submit(_check_and_write, parts, in_tree, inputs, out, path))
+        inputs = jax.tree_util.tree_map(_frozen, dynamic)  # the caller may change its arrays
+        _writing.append(_background().submit(_check_and_write, compiled, in_tree, inputs, out, path))
     except Exception:
-        pass  # not serializable here: run it all the same
+        pass  # no thread to write it: run it all the same
     return _Loaded(compiled, path, in_tree), out
 
 
@@ -490,13 +488,14 @@ def _frozen(leaf):
     return np.array(leaf) if isinstance(leaf, np.ndarray) else leaf
 
 
-def _check_and_write(parts, in_tree, args, out, path):
+def _check_and_write(compiled, in_tree, args, out, path):
     try:
-        blob = _checked_bytes(parts, in_tree, args, out)
+        parts = _serialized(compiled)
+        blob = None if parts is None else _checked_bytes(parts, in_tree, args, out)
         if blob is not None:
             _write(path, blob)
     except Exception:
-        pass  # the folder is read-only, or the copy failed: no file
+        pass  # not serializable here, the copy failed or the folder is read-only: no file
 
 
 def finish_writing():
