@@ -88,6 +88,7 @@ counts = collections.Counter()
 ahead_counts = collections.Counter()
 _previous = None  # the key of the program this process asked for last
 _ahead = {}  # key -> Future of a program read ahead
+_asked = set()  # the keys this process asked for (never read ahead again)
 _reader = None  # the background threads (reading ahead, checking and writing new programs)
 _writing = []  # futures of the files being checked and written
 
@@ -433,6 +434,7 @@ def _follow(key):
     of it outside Python's lock) then overlaps the cells before it is needed."""
     global _previous
     previous, _previous = _previous, key
+    _asked.add(key)
     try:
         if previous is not None and previous != key:
             marker = _root / f"{previous}.next"
@@ -444,8 +446,8 @@ def _follow(key):
             if _broken or not marker.exists():
                 break
             following = marker.read_text().strip()
-            if following == key or following in _ahead or not following.isalnum():
-                continue
+            if following in _asked or following in _ahead or not following.isalnum():
+                continue  # already here, already loading, or not a key
             _ahead[following] = _background().submit(_load, _root / f"{following}.bin")
     except OSError:
         pass

@@ -134,6 +134,7 @@ def store(tmp_path, monkeypatch):
     monkeypatch.setattr(program_store, "ahead_counts", program_store.collections.Counter())
     monkeypatch.setattr(program_store, "_previous", None)
     monkeypatch.setattr(program_store, "_ahead", {})
+    monkeypatch.setattr(program_store, "_asked", set())
     monkeypatch.setattr(program_store, "_writing", [])
     assert program_store.open_store(tmp_path) is not None
     return program_store
@@ -260,12 +261,16 @@ def test_programs_are_read_ahead_in_the_order_they_were_used(store):
     assert len(list(store._root.glob("*.next"))) == 3
     program._loaded.clear()  # as in a new process
     store._previous = None
+    store._asked.clear()
     assert float(program(jnp.arange(3.0), 1.0, power=2)) == 5.0
+    first = store._previous
     assert len(store._ahead) == 3  # 4, 5 and 6 are loading
     for n in sizes[1:]:
         assert float(program(jnp.arange(float(n)), 1.0, power=2)) == sum(k * k for k in range(n))
     assert store.ahead_counts["ready"] + store.ahead_counts["waited"] == 3
     assert store.counts["loaded"] == 4 and not store._ahead
+    store._follow(first)  # 4, 5 and 6 follow it, but this process has them already
+    assert not store._ahead
 
 
 def test_a_program_read_ahead_for_other_arguments_is_not_used(store):
@@ -280,6 +285,7 @@ def test_a_program_read_ahead_for_other_arguments_is_not_used(store):
     second.write_bytes(program_store.pickle.dumps(foreign))  # claims another input structure
     program._loaded.clear()
     store._previous = None
+    store._asked.clear()
     program(jnp.arange(3.0), 1.0, power=2)
     assert float(program(jnp.arange(4.0), 1.0, power=2)) == 14.0
     assert store.ahead_counts["unused"] == 1 and store.counts["compiled"] == 3
