@@ -105,6 +105,20 @@ def depth_levels(parents):
     return [np.flatnonzero(depth == d) for d in range(depth.max() + 1)]
 
 
+def level_table(parents):
+    """The roots, then one row per deeper level: its joints and their parents, padded to the
+    widest level with joint n (a spare slot past the last joint): shapes (L-1, width)."""
+    levels = depth_levels(parents)
+    n = len(parents)
+    width = max([len(level) for level in levels[1:]] or [1])
+    joints = np.full((len(levels) - 1, width), n)
+    ups = np.full((len(levels) - 1, width), n)
+    for row, level in enumerate(levels[1:]):
+        joints[row, :len(level)] = level
+        ups[row, :len(level)] = np.asarray(parents)[level]
+    return levels[0], joints, ups
+
+
 @partial(xla.jit, fast_compile=False)  # kept on disk: tracing a big tree takes 0.1-0.2 s
 def tree_frames(arm, theta):
     """World joint positions (n, 3), world axes (n, 3) and effector positions (m, 3).
@@ -114,7 +128,7 @@ def tree_frames(arm, theta):
     effector k on joint j:  x_k = p_j + R_j (rest_k - rest_j).
     The joints of one depth are done together (their parents are all one level up), so the
     walk takes one step per level of the tree, not one per joint: a 25-joint tree of 9 levels
-    walks in 4 us instead of 27 us.
+    walks in 5 us instead of 27 us.
     """
     theta = jnp.asarray(theta, dtype=float)
     rest, axes = jnp.asarray(arm.positions), jnp.asarray(arm.axes)
@@ -126,19 +140,23 @@ def tree_frames(arm, theta):
     offset = rest - rest[np.maximum(parents, 0)]  # rest_j - rest_parent
     # R_parent [Rot_j | offset_j | a_j] = [R_j | p_j - p_parent | z_j]: one product per level
     columns = jnp.concatenate([turn, offset[:, :, None], axes[:, :, None]], axis=2)
-    levels = depth_levels(arm.parents)
-    Rs, ps, zs = [turn[levels[0]]], [rest[levels[0]]], [axes[levels[0]]]  # the roots
-    for above, level in zip(levels, levels[1:]):
-        at = np.searchsorted(above, parents[level])  # each parent's place in the level above
-        product = Rs[-1][at] @ columns[level]
-        Rs.append(product[:, :, :3])
-        ps.append(ps[-1][at] + product[:, :, 3])
-        zs.append(product[:, :, 4])
-    joint_order = np.argsort(np.concatenate(levels))
-    R, p, z = (jnp.concatenate(parts)[joint_order] for parts in (Rs, ps, zs))
+    columns = jnp.concatenate([columns, jnp.zeros((1, 3, 5))])  # the spare slot n
+    roots, joints, ups = level_table(arm.parents)
+    R = jnp.zeros((n + 1, 3, 3)).at[roots].set(turn[roots])
+    p = jnp.zeros((n + 1, 3)).at[roots].set(rest[roots])
+    z = jnp.zeros((n + 1, 3)).at[roots].set(axes[roots])
+
+    def level(frames, row):
+        R, p, z = frames
+        js, us = row
+        product = R[us] @ columns[js]
+        return (R.at[js].set(product[:, :, :3]), p.at[js].set(p[us] + product[:, :, 3]),
+                z.at[js].set(product[:, :, 4])), None
+
+    (R, p, z), _ = jax.lax.scan(level, (R, p, z), (jnp.asarray(joints), jnp.asarray(ups)))
     on = np.asarray(arm.effector_parents)
     x = p[on] + jnp.einsum("kab,kb->ka", R[on], jnp.asarray(arm.effectors) - rest[on])
-    return p, z, x
+    return p[:n], z[:n], x
 
 
 @partial(xla.jit, fast_compile=False)
