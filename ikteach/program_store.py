@@ -480,6 +480,7 @@ def _compile_and_save(jitted, positional, dynamic, in_tree, path):
         return None, None  # jit raises it again, with its own message
     try:
         inputs = jax.tree_util.tree_map(_frozen, dynamic)  # the caller may change its arrays
+        _writing[:] = [f for f in _writing if not f.done()]
         _writing.append(_background().submit(_check_and_write, compiled, in_tree, inputs, out, path))
     except Exception:
         pass  # no thread to write it: run it all the same
