@@ -37,6 +37,7 @@ import pickle
 import platform
 import sys
 import tempfile
+import threading
 import time
 import types
 import warnings
@@ -44,7 +45,6 @@ import warnings
 import jax
 import numpy as np
 
-from . import lapack_tables
 
 FORMAT = "ikteach-program-5"
 SUBFOLDER = "programs"
@@ -80,6 +80,7 @@ _works = None  # store_works(), once per process
 _broken = False  # a stored program misbehaved: plain jax.jit for the rest of the process
 _source = None
 _lapack_ready = None
+_lapack_lock = threading.Lock()
 # What the store did this session: programs "loaded" from disk, "compiled" (and written),
 # calls left to "plain" jax.jit because the key was not certain.
 counts = collections.Counter()
@@ -370,23 +371,26 @@ def lapack_ready():
     program loaded without lowering anything would call through null pointers (a crash), so
     jax.export does it before loading too. False where this jaxlib has no such call."""
     global _lapack_ready
-    if _lapack_ready is None:
-        _lapack_ready = False
-        lapack_tables.preload()
-        try:
-            from jax._src.lax import linalg
-
-            linalg.initialize_lapack()
-            _lapack_ready = True
-        except Exception:
-            try:
-                from jaxlib.cpu import _lapack
-
-                _lapack.initialize()
-                _lapack_ready = True
-            except Exception:
-                pass
+    with _lapack_lock:  # the background threads ask too
+        if _lapack_ready is None:
+            _lapack_ready = _initialize_lapack()
     return _lapack_ready
+
+
+def _initialize_lapack():
+    try:
+        from jax._src.lax import linalg
+
+        linalg.initialize_lapack()
+        return True
+    except Exception:
+        try:
+            from jaxlib.cpu import _lapack
+
+            _lapack.initialize()
+            return True
+        except Exception:
+            return False
 
 
 def _load(path, in_tree=None):
@@ -578,7 +582,8 @@ def store_works():
 
 def calls_lapack(compiled):
     """Does the program call jaxlib's LAPACK kernels (SVD, solves)? Those need lapack_ready()
-    before it runs (0.02 s with lapack_tables.preload): loads of other programs skip it."""
+    before it runs (scipy's tables were loaded at import, see lapack_tables): loads of other
+    programs skip it."""
     try:
         return 'custom_call_target="lapack_' in compiled.as_text()
     except Exception:
