@@ -66,12 +66,14 @@ def arm_anchors(positions, axes):
     its axis) and the end-effector sphere. Each part is symmetric about its direction, so a
     part at one pose moves to another by the rigid motion of its anchor."""
     anchors = [(positions[0], UP_Z)]
-    for a, b in zip(positions[:-1], positions[1:]):
-        length = np.linalg.norm(b - a)
-        if length > 1e-9:
-            anchors.append((a, (b - a) / length))
+    anchors += [(a, (b - a) / np.linalg.norm(b - a)) for a, b in _links(positions)]
     anchors += [(p, w / np.linalg.norm(w)) for p, w in zip(positions[:-1], axes)]
     return anchors + [(positions[-1], UP_Z)]
+
+
+def _links(positions):
+    """(start, end) of each link of non-zero length, from the base to the end effector."""
+    return [(a, b) for a, b in zip(positions[:-1], positions[1:]) if np.linalg.norm(b - a) > 1e-9]
 
 
 def arm_meshes(arm, theta, scale=None):
@@ -82,9 +84,8 @@ def arm_meshes(arm, theta, scale=None):
     positions, axes, _ = frames(arm, theta)
     parts = [(pv.Cylinder(center=positions[0] - [0, 0, 0.03 * scale], direction=(0, 0, 1),
                           radius=0.09 * scale, height=0.06 * scale), COLORS["base"])]
-    for a, b in zip(positions[:-1], positions[1:]):
-        if np.linalg.norm(b - a) > 1e-9:
-            parts.append((pv.Tube(pointa=a, pointb=b, radius=0.022 * scale, n_sides=16), COLORS["link"]))
+    for a, b in _links(positions):
+        parts.append((pv.Tube(pointa=a, pointb=b, radius=0.022 * scale, n_sides=16), COLORS["link"]))
     for p, w in zip(positions[:-1], axes):
         parts.append((pv.Cylinder(center=p, direction=w, radius=0.045 * scale,
                                   height=0.11 * scale, resolution=24), COLORS["joint"]))
@@ -207,7 +208,7 @@ def _scene(arm, theta, target, trail, window_size, ghost, plotter):
 
 
 def _posed_arm(plotter, arm, theta, scale):
-    """The arm (smooth shaded) and its end triad, as MovingParts; pose_anchors(theta) moves them."""
+    """The arm (smooth shaded) and its end triad, as MovingParts; _move_arm moves them."""
     positions, axes, T = frames(arm, theta)
     arm_parts = MovingParts(plotter, arm_meshes(arm, theta, scale), arm_anchors(positions, axes),
                             smooth_shading=True)
@@ -296,7 +297,7 @@ def solve_gif(arm, trace_theta, path, target=None, frames_max=30, fps=8, window_
     scale = float(reach(arm))
     p = pv.Plotter(window_size=list(window_size), off_screen=True)
     p.open_gif(str(path), fps=fps)
-    _, pose = _scene(arm, thetas[idx[0]], target, ends[: idx[0] + 1], window_size, None, p)
+    _, pose = _scene(arm, thetas[idx[0]], target, None, window_size, None, p)  # trail: below
     for k in idx:
         _move_arm(pose, arm, thetas[k])
         _draw_trail(p, ends[: k + 1], scale)
