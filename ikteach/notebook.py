@@ -6,6 +6,8 @@ import sys
 
 import numpy as np
 
+from . import heap
+
 SEED = 0
 CACHE_ENV = "IKTEACH_JAX_CACHE"  # a folder for compiled code, or "off"
 
@@ -39,6 +41,7 @@ def setup(seed=SEED, pyvista=None):
     compilation_cache()
     _setup_alt_text()
     print_versions()
+    heap.settle()  # after the imports above: see ikteach/heap.py
     return np.random.default_rng(seed)
 
 
