@@ -36,12 +36,20 @@ def run_seconds(path, cache):
     return time.perf_counter() - t0
 
 
+def loop_seconds():
+    """Seconds for a fixed pure-Python loop (10 million squares): this machine's speed now."""
+    t0 = time.perf_counter()
+    sum(i * i for i in range(10_000_000))
+    return time.perf_counter() - t0
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("notebooks", nargs="*", type=Path)
     args = ap.parse_args()
     paths = args.notebooks or sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))
-    print(f"{os.cpu_count()} CPU cores; python {sys.version.split()[0]}")
+    print(f"{os.cpu_count()} CPU cores; python {sys.version.split()[0]}; "
+          f"reference loop {loop_seconds():.2f} s")
     print(f"| {'notebook':<36} | {'cold s':>7} | {'warm s':>7} | {'warm max':>8} | {'goal':>9} |")
     print(f"|{'-' * 38}|{'-' * 9}|{'-' * 9}|{'-' * 10}|{'-' * 11}|")
     totals = [0.0, 0.0]
@@ -56,6 +64,7 @@ def main():
         print(f"| {path.name:<36} | {cold:>7.1f} | {warm:>7.1f} | {warms[-1]:>8.1f} | {ok:>9} |",
               flush=True)
     print(f"| {'total':<36} | {totals[0]:>7.1f} | {totals[1]:>7.1f} | {'':>8} | {'':>9} |")
+    print(f"reference loop {loop_seconds():.2f} s")
 
 
 if __name__ == "__main__":
