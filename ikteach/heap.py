@@ -9,11 +9,13 @@ notebook, and several times more while the kernel shut down, 0.4-0.7 s per noteb
 import atexit
 import gc
 
-_at_exit = []
+_settled = []
 
 
 def settle():
-    """Freeze what is alive now, and freeze what is left at exit (the exit hook once)."""
-    gc.freeze()
-    if not _at_exit:
-        _at_exit.append(atexit.register(gc.freeze))
+    """Freeze what is alive now and, at exit, what is left; only on the first call, so that
+    running the setup cell again never freezes a notebook's own figures and data (a frozen
+    cycle is never freed)."""
+    if not _settled:
+        gc.freeze()
+        _settled.append(atexit.register(gc.freeze))
