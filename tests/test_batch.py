@@ -33,3 +33,43 @@ def test_batch_accepts_a_jax_step_function():
     targets = np.array([[1.0, 1.0], [2.0, 0.5]])
     res = ik.solve_batch(ARM, targets, START, method=lambda J, e: ik.dls_step(J, e, 0.3))
     assert list(res.status) == ["converged", "converged"]
+
+
+def _same(a, b):
+    for field in ("theta", "iterations", "error"):
+        np.testing.assert_array_equal(getattr(a, field), getattr(b, field))  # to the bit
+    assert list(a.status) == list(b.status)
+
+
+def _small_then_queued(monkeypatch, solve):
+    """solve() with SMALL_BATCH targets (the queue must not run), then through the queue."""
+    from ikteach import batch
+
+    def no_queue(*args, **kwargs):
+        raise AssertionError("a small batch went through the queue")
+
+    with monkeypatch.context() as patch:
+        patch.setattr(batch, "_run_queue", no_queue)
+        small = solve(batch.SMALL_BATCH)
+    with monkeypatch.context() as patch:
+        patch.setattr(batch, "SMALL_BATCH", 0)
+        return small, solve(len(small))
+
+
+@pytest.mark.parametrize("method", ["jt", "pinv", "dls", "sdls", "ccd", "fabrik"])
+def test_a_small_batch_solves_one_by_one_with_the_queues_bits(method, monkeypatch):
+    targets = np.random.default_rng(3).uniform(-3.5, 3.5, size=(64, 2))
+    _same(*_small_then_queued(monkeypatch, lambda k: ik.solve_batch(
+        ARM, targets[:k], START, method=method, clamp=0.5, max_iter=300)))
+
+
+def test_a_small_batch_of_tree_and_pose_targets_has_the_queues_bits(monkeypatch):
+    Y = ik.buss_trees.y_tree()
+    goals = np.random.default_rng(4).uniform(-0.6, 0.6, (64, Y.n_joints))
+    tree_targets = np.stack([np.asarray(ik.tree_fk(Y, g)) for g in goals])
+    _same(*_small_then_queued(monkeypatch, lambda k: ik.solve_batch(
+        Y, tree_targets[:k], np.zeros(Y.n_joints), method="sdls", tol=1e-4, max_iter=500)))
+    ur5 = ik.ur5()
+    poses = np.stack([np.asarray(ik.fk_pose(ur5, g[:6])) for g in goals])
+    _same(*_small_then_queued(monkeypatch, lambda k: ik.solve_batch(
+        ur5, poses[:k], np.full(6, 0.2), method="dls", tol=1e-6, max_iter=300, damping=0.05)))
