@@ -151,9 +151,11 @@ def _run(method, task, arm, targets, thetas0, settings, max_iter):
 
 
 def _one_by_one(method, task, arm, targets, thetas0, settings, max_iter):
-    """ik.solve's compiled loop (no trace) on each row, the states stacked row by row."""
-    states = [_run_jit(method, task, arm, targets[k], thetas0[k], settings, max_iter, False)
-              for k in range(targets.shape[0])]
+    """ik.solve's compiled loop (no trace) on each row, the states stacked row by row. The rows
+    are cut on the host: indexing a device array would dispatch two small programs per row."""
+    rows, starts = np.asarray(targets), np.asarray(thetas0)
+    states = [_run_jit(method, task, arm, rows[k], starts[k], settings, max_iter, False)
+              for k in range(rows.shape[0])]
     return jax.tree_util.tree_map(lambda *rows: np.stack([np.asarray(r) for r in rows]), *states)
 
 
