@@ -359,7 +359,7 @@ class StoredProgram:
 class _Loaded:
     """A Compiled with the file it came from (deleted should it fail) and its input tree."""
 
-    def __init__(self, compiled, store_path, in_tree=None):
+    def __init__(self, compiled, store_path, in_tree):
         self.compiled, self.store_path, self.in_tree = compiled, store_path, in_tree
 
     def __call__(self, *args):
