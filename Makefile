@@ -65,23 +65,23 @@ binder/constraints.txt: uv.lock
 # The course's public home (pyproject.toml [project.urls]) -> every notebook's first code cell
 # and the Colab/Binder badges in README.md and notebooks/README.md.
 header: $(STAMP)
-	$(PY) -m ikteach.notebook_header
+	$(PY) -m ikteach.course.notebook_header
 
 # Strip run noise (timestamps, widget state, kernel versions) from every committed notebook.
 strip: $(STAMP)
-	$(PY) -m ikteach.notebook_strip $(NOTEBOOKS)
+	$(PY) -m ikteach.course.notebook_strip $(NOTEBOOKS)
 
 # Re-execute every notebook with the locked versions, then strip: what to commit.
 notebooks: $(STAMP)
-	$(PY) -m ikteach.notebook_header
-	$(PY) -m ikteach.exercises build
+	$(PY) -m ikteach.course.notebook_header
+	$(PY) -m ikteach.course.exercises build
 	@for nb in notebooks/*.ipynb instructor/solutions/*.ipynb; do echo "== $$nb"; \
 		$(VENV)/bin/jupyter nbconvert --to notebook --execute --inplace \
 			--ExecutePreprocessor.timeout=900 $$nb || exit 1; done
-	$(PY) -m ikteach.notebook_strip $(NOTEBOOKS)
+	$(PY) -m ikteach.course.notebook_strip $(NOTEBOOKS)
 
 exercises: $(STAMP)
-	$(PY) -m ikteach.exercises build
+	$(PY) -m ikteach.course.exercises build
 
 clean:
 	rm -rf $(VENV) $(LATEST_VENV) .pytest_cache .hypothesis

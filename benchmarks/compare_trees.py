@@ -10,7 +10,7 @@ import argparse
 import numpy as np
 
 import ikteach as ik
-from ikteach import buss_trees as bt
+from ikteach.core import buss_trees as bt
 
 TREES = {"y": (bt.y_tree, bt.y_targets), "double_y": (bt.double_y_tree, bt.double_y_targets)}
 

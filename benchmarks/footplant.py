@@ -8,7 +8,7 @@ import time
 
 import numpy as np
 
-from ikteach import bvh, clip_ik, footplant, skeleton
+from ikteach.characters import bvh, clip_ik, footplant, skeleton
 
 LONG_LEGS = {"LeftLeg": 1.2, "RightLeg": 1.2, "LeftFoot": 1.1, "RightFoot": 1.1}  # as notebook 09
 

@@ -1,4 +1,4 @@
-"""Grading time for a class: N students x 6 exercise notebooks, python -m ikteach.grade --jobs J.
+"""Grading time for a class: N students x 6 exercise notebooks, python -m ikteach.course.grade --jobs J.
 
     .venv/bin/python benchmarks/grade_class.py [--students 30] [--jobs 2] [--exercises 6]
 
@@ -45,7 +45,7 @@ def main():
         n_books, solved = build_class(tmp / "class", args.students, args.exercises)
         out = tmp / "out" / "grades.csv"
         t0 = time.perf_counter()
-        run = subprocess.run([sys.executable, "-m", "ikteach.grade", str(tmp / "class"),
+        run = subprocess.run([sys.executable, "-m", "ikteach.course.grade", str(tmp / "class"),
                               "--out", str(out), "--jobs", str(args.jobs)],
                              capture_output=True, text=True, cwd=tmp)
         wall = time.perf_counter() - t0

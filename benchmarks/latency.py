@@ -80,7 +80,7 @@ def demo_rows(n, rng):
 
 
 def map_rows(n, grid_n, rng):
-    from ikteach import live_map
+    from ikteach.pictures import live_map
 
     header(f"live workspace map (notebook 07): {grid_n} x {grid_n} solve_batch + redraw, "
            f"{max(n // 4, 5)} lambda changes")

@@ -18,7 +18,7 @@ from pathlib import Path
 import nbformat
 from nbclient import NotebookClient
 
-from ikteach.notebook import CACHE_ENV
+from ikteach.course.notebook import CACHE_ENV
 
 ROOT = Path(__file__).resolve().parents[1]
 COLD_GOAL_S, WARM_GOAL_S = 15.0, 5.0

@@ -16,8 +16,8 @@ import jax
 import numpy as np
 
 import ikteach as ik
-from ikteach import batch as batch_module
-from ikteach.solve import STALL_FRACTION
+from ikteach.core import batch as batch_module
+from ikteach.core.solve import STALL_FRACTION
 
 import native  # benchmarks/native: the scalar C loop
 

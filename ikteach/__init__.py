@@ -1,59 +1,63 @@
 """ikteach: inverse kinematics for a computer-animation course.
 
-Importing ikteach switches JAX to 64-bit floats, so every result is float64.
-Modules that pull in heavy libraries (matplotlib, ipywidgets, pyvista, scikit-image)
-load on first use: `ik.plot`, `ik.demo`, `ik.scene`, `ik.workspace`... are in LAZY.
+Importing ikteach switches JAX to 64-bit floats (jax_enable_x64), so every result is
+float64. That is the only global change it makes: the CPU device count, the garbage
+collector and sys.modules are left as they were (ik.notebook.setup() is where a notebook
+opts into kernel-wide settings).
+
+The package by concern (arrows point down; nothing imports upward):
+  ikteach.course      exercise checks, grading and its sandbox, notebook setup/header/strip
+  ikteach.pictures    2-D plots and animations, 3-D scenes, the demo, live maps, alt text
+  ikteach.characters  BVH, skeletons, the walk, foot planting, clip IK, look-at
+  ikteach.core        the IK a student reads: chains, Jacobians, steps, the solve loop
+  ikteach._runtime    jax.jit for the whole-loop programs (compiler options, program bound)
+Pictures and course load on first use (`ik.plot`, `ik.demo`, `ik.check`...: LAZY below).
 """
 import importlib
 
 import jax
 
-from . import host_devices
-
 jax.config.update("jax_enable_x64", True)
-host_devices.request(jax)  # one CPU device per core, for solve_batch (before JAX starts)
 
-from . import lapack_tables  # noqa: E402
-
-lapack_tables.preload()  # the first SVD or solve lowers without importing scipy.linalg (0.2 s)
-
-from .chain import Chain, planar_chain, serial_chain, reach  # noqa: E402
-from .kinematics import fk, joint_positions, joint_frames, rotation_about  # noqa: E402
-from .jacobian import jacobian, jacobian_autodiff, jacobian_fd  # noqa: E402
-from .jt import jt_step, optimal_alpha  # noqa: E402
-from .pinv import pinv_step  # noqa: E402
-from .dls import dls_step, dls_step_normal  # noqa: E402
-from .limits import clamp_error, cap_step  # noqa: E402
-from .priority import priority_step, multilevel_step, damped_pinv, null_projector  # noqa: E402
-from .solve import solve, Result, Trace, STATUSES, METHODS  # noqa: E402
-from .solve import StopSolve  # noqa: E402
-from .batch import solve_batch, BatchResult  # noqa: E402
-from . import notebook  # noqa: E402
-from .sdls import sdls_step, GAMMA_MAX  # noqa: E402
-from .ccd import ccd_sweep, ccd_angle  # noqa: E402
-from .fabrik import fabrik_pass  # noqa: E402
-from .tree import Tree, tree, tree_fk, tree_frames, tree_jacobian, tree_jacobian_autodiff  # noqa: E402
-from .tree import tree_jacobian_from_frames  # noqa: E402
-from .track import track, TrackResult  # noqa: E402
-from .jitter import jitter, jitter_per_step  # noqa: E402
-from . import stop_rules, settle  # noqa: E402
-from . import buss_trees  # noqa: E402
-from .pose import fk_pose, rotation_log, rotation_exp, pose_errors, make_pose, PoseTask  # noqa: E402
-from .robots import ur5, iiwa14  # noqa: E402
-from . import robots  # noqa: E402
-from . import bvh, skeleton, clip_ik, footplant, look_at  # noqa: E402  (characters: BVH, rigs, foot planting)
+from .core.chain import Chain, planar_chain, serial_chain, reach  # noqa: E402
+from .core.kinematics import fk, joint_positions, joint_frames, rotation_about  # noqa: E402
+from .core.jacobian import jacobian, jacobian_autodiff, jacobian_fd  # noqa: E402
+from .core.jt import jt_step, optimal_alpha  # noqa: E402
+from .core.pinv import pinv_step  # noqa: E402
+from .core.dls import dls_step, dls_step_normal  # noqa: E402
+from .core.limits import clamp_error, cap_step  # noqa: E402
+from .core import jt, pinv, dls, sdls, ccd, fabrik, priority, joint_limits, levels, tasks  # noqa: E402,F401
+from .core.priority import priority_step, multilevel_step, damped_pinv, null_projector  # noqa: E402
+from .core.solve import solve, Result, Trace, STATUSES, METHODS  # noqa: E402
+from .core.solve import StopSolve  # noqa: E402
+from .core.batch import solve_batch, BatchResult  # noqa: E402
+from .course import notebook  # noqa: E402
+from .core.sdls import sdls_step, GAMMA_MAX  # noqa: E402
+from .core.ccd import ccd_sweep, ccd_angle  # noqa: E402
+from .core.fabrik import fabrik_pass  # noqa: E402
+from .core.tree import Tree, tree, tree_fk, tree_frames, tree_jacobian, tree_jacobian_autodiff  # noqa: E402
+from .core.tree import tree_jacobian_from_frames  # noqa: E402
+from .core.track import track, TrackResult  # noqa: E402
+from .core.jitter import jitter, jitter_per_step  # noqa: E402
+from .core import stop_rules, settle  # noqa: E402
+from .core import buss_trees  # noqa: E402
+from .core.pose import fk_pose, rotation_log, rotation_exp, pose_errors, make_pose, PoseTask  # noqa: E402
+from .core.robots import ur5, iiwa14  # noqa: E402
+from .core import robots  # noqa: E402
+from .characters import bvh, skeleton, clip_ik, footplant, look_at  # noqa: E402  (characters: BVH, rigs, foot planting)
 
 # name -> (submodule, attribute or None for the module itself): imported on first use.
 LAZY = {
-    "check": ("check", None),
-    "plot": ("plot", None),
-    "demo": ("demo", None),
-    "scene": ("scene", None),
-    "workspace": ("workspace", None),
-    "tree_plot": ("tree_plot", None),
-    "live_map": ("live_map", None),
-    "character_plot": ("character_plot", None),
-    "character_scene": ("character_scene", None),
+    "check": ("course.check", None),
+    "plot": ("pictures.plot", None),
+    "alt_text": ("pictures.alt_text", None),
+    "demo": ("pictures.demo", None),
+    "scene": ("pictures.scene", None),
+    "workspace": ("pictures.workspace_maps", None),
+    "tree_plot": ("pictures.tree_plot", None),
+    "live_map": ("pictures.live_map", None),
+    "character_plot": ("pictures.character_plot", None),
+    "character_scene": ("pictures.character_scene", None),
 }
 
 

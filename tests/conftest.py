@@ -12,7 +12,7 @@ collect_ignore_glob = ["submissions/*"]
 
 # Compiled programs are kept on disk between runs, as in the notebooks (ik.notebook.setup):
 # a second `make test` loads them instead of compiling (IKTEACH_JAX_CACHE=off turns it off).
-from ikteach.notebook import compilation_cache  # noqa: E402
+from ikteach.course.notebook import compilation_cache  # noqa: E402
 
 compilation_cache()
 

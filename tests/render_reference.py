@@ -23,7 +23,7 @@ def scene_image(theta=SCENE_THETA, colors=None):
     """The UR5 at theta with a pose target and its end frame, rendered off screen."""
     import pyvista as pv
 
-    from ikteach import scene
+    from ikteach.pictures import scene
 
     pv.OFF_SCREEN = True
     saved = dict(scene.COLORS)
@@ -48,7 +48,7 @@ def map_image(lengths=MAP_ARM, n=96, cmap="viridis"):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ikteach import workspace as ws
+    from ikteach.pictures import workspace_maps as ws
 
     arm = ik.planar_chain(lengths)
     grid = ws.target_grid(arm, n)

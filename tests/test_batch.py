@@ -43,7 +43,7 @@ def _same(a, b):
 
 def _small_then_queued(monkeypatch, solve):
     """solve() with SMALL_BATCH targets (the queue must not run), then through the queue."""
-    from ikteach import batch
+    from ikteach.core import batch
 
     def no_queue(*args, **kwargs):
         raise AssertionError("a small batch went through the queue")

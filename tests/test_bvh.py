@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 import ikteach as ik
-from ikteach import bvh, skeleton, walk
+from ikteach.characters import bvh, skeleton, walk
 
 # Channel orders other than ZXY, a root offset, a joint without channels and an end site:
 # forward kinematics must agree with bvhio (an independent reader) on all of it.

@@ -4,7 +4,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import ikteach as ik
-from ikteach.fabrik import fabrik_pass
+from ikteach.core.fabrik import fabrik_pass
 from strategies import arm_and_angles, planar_arms
 
 ARM = ik.planar_chain([1.0, 1.0, 1.0])

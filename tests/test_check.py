@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 import ikteach as ik
-from ikteach import check
+from ikteach.course import check
 
 
 def planar_jacobian(lengths, theta):

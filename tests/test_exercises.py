@@ -6,7 +6,7 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from ikteach import exercises
+from ikteach.course import exercises
 
 ROOT = Path(__file__).resolve().parents[1]
 SOLUTIONS = sorted((ROOT / "instructor" / "solutions").glob("*.ipynb"))
@@ -20,7 +20,7 @@ def test_one_template_per_solution():
 
 @pytest.mark.parametrize("solution", SOLUTIONS, ids=lambda p: p.name)
 def test_template_is_built_from_its_solution(solution):
-    """The committed template is what `python -m ikteach.exercises build` makes of it."""
+    """The committed template is what `python -m ikteach.course.exercises build` makes of it."""
     built = exercises.template_from(nbformat.read(solution, as_version=4))
     template = nbformat.read(ROOT / "notebooks" / "exercises" / solution.name, as_version=4)
     assert [c.source for c in template.cells] == [c.source for c in built.cells]

@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 
 import ikteach as ik
-from ikteach import batch
-from ikteach.small_solve import solve_small
-from ikteach.solve import linearize
-from ikteach.tasks import PositionTask
+from ikteach.core import batch
+from ikteach.core.small_solve import solve_small
+from ikteach.core.solve import linearize
+from ikteach.core.tasks import PositionTask
 
 RNG = np.random.default_rng(11)
 
@@ -99,7 +99,7 @@ def _two_row_jacobians():
 
 
 def test_the_two_row_pseudoinverse_equals_the_svd_one():
-    from ikteach.pinv import pinv_two_rows
+    from ikteach.core.pinv import pinv_two_rows
 
     for J, e in _two_row_jacobians():
         want = np.asarray(ik.pinv_step(J, e))
@@ -111,7 +111,7 @@ def test_the_two_row_pseudoinverse_equals_the_svd_one():
 
 @pytest.mark.parametrize("rcond", [1e-6, 0.5])
 def test_the_two_row_pseudoinverse_drops_the_same_singular_values(rcond):
-    from ikteach.pinv import pinv_two_rows
+    from ikteach.core.pinv import pinv_two_rows
 
     J = np.array([[1.0, 0.0, 0.0], [0.0, 0.4, 0.0]])  # sigma 1 and 0.4
     e = np.array([1.0, 1.0])

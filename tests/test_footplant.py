@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from ikteach import bvh, clip_ik, footplant, skeleton, walk
+from ikteach.characters import bvh, clip_ik, footplant, skeleton, walk
 
 LONG_LEGS = {"LeftLeg": 1.2, "RightLeg": 1.2, "LeftFoot": 1.1, "RightFoot": 1.1}  # thighs, shins
 FEET = ["LeftFoot", "RightFoot"]
@@ -26,7 +26,7 @@ def test_contacts_match_the_generators_stance_phases(clip):
     sk, motion = clip
     contact = footplant.contacts(_feet(sk, motion), motion.frame_time, height=9.0, speed=15.0)
     t = np.arange(len(motion)) * motion.frame_time
-    for k, phase in enumerate([0.0, 0.5]):          # left, right (see ikteach/walk.py)
+    for k, phase in enumerate([0.0, 0.5]):          # left, right (see ikteach/characters/walk.py)
         u = t / walk.CYCLE - phase
         stance = (u - np.floor(u)) < walk.DUTY
         found, truth = footplant.intervals(contact[:, k]), footplant.intervals(stance)

@@ -1,4 +1,4 @@
-"""python -m ikteach.grade on the solutions, the untouched templates, the wrong and the hostile
+"""python -m ikteach.course.grade on the solutions, the untouched templates, the wrong and the hostile
 submissions (tests/submissions/, written by make_hostile.py).
 
 One grading run (two notebooks at a time) serves every test here.
@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from ikteach import grade
+from ikteach.course import grade
 
 ROOT = Path(__file__).resolve().parents[1]
 WRONG = ROOT / "tests" / "submissions"
@@ -37,7 +37,7 @@ def graded(tmp_path_factory):
     for path in ESCAPES:
         path.unlink(missing_ok=True)
     out = base / "out" / "grades.csv"
-    run = subprocess.run([sys.executable, "-m", "ikteach.grade", str(subs), "--out", str(out),
+    run = subprocess.run([sys.executable, "-m", "ikteach.course.grade", str(subs), "--out", str(out),
                           "--timeout", "10", "--jobs", "2"],
                          capture_output=True, text=True, timeout=1500, cwd=base)
     assert run.returncode == 0, run.stderr[-3000:]
@@ -90,7 +90,7 @@ def test_wrong_submissions_get_partial_marks_and_the_right_feedback(graded, stud
 
 # hostile submissions: (student, exercise, marks, a line of its feedback)
 HOSTILE = [
-    # replaces ik.check.grade, ik.check.pinv_step and sys.modules["ikteach.check"]: template
+    # replaces ik.check.grade, ik.check.pinv_step and sys.modules["ikteach.course.check"]: template
     ("forge_check", 3, 0, "not yet implemented"),
     # prints fake grade lines, replaces print, sys.stdout and the display hook: template
     ("forge_output", 2, 0, "not yet implemented"),

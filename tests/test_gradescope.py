@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from ikteach.grading import gradescope
+from ikteach.course.grading import gradescope
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -43,8 +43,8 @@ def run_autograder(source, tmp_path, notebook):
 
 def test_the_bundle_holds_the_scripts_and_no_solutions(bundle):
     source, names = bundle
-    assert {"setup.sh", "run_autograder", "ikteach/grade.py",
-            "ikteach/check/ex01_jacobian.py"} <= names
+    assert {"setup.sh", "run_autograder", "ikteach/course/grade.py",
+            "ikteach/course/check/ex01_jacobian.py"} <= names
     assert not [n for n in names if n.startswith("instructor") or "solution" in n.lower()]
     assert "bubblewrap" in (source / "setup.sh").read_text()
 

@@ -12,7 +12,7 @@ def _run(code):
 def test_settle_freezes_the_heap_and_later_cycles_are_still_collected():
     code = """
 import atexit, gc
-from ikteach import heap
+from ikteach.course import heap
 before = atexit._ncallbacks()
 heap.settle()
 frozen = gc.get_freeze_count()
@@ -31,7 +31,7 @@ def test_what_is_left_at_exit_is_frozen_before_shutdown_sweeps_it():
     code = """
 import atexit, gc
 atexit.register(lambda: print(len(gc.get_objects())))  # runs after settle's hook
-from ikteach import heap
+from ikteach.course import heap
 heap.settle()
 kept = [[i] for i in range(10_000)]   # made after settle: tracked until the exit hook
 print(len(gc.get_objects()) >= 10_000)
@@ -43,3 +43,26 @@ def test_setup_settles_the_heap():
     code = ("import gc, ikteach as ik; ik.notebook.setup(); "
             "print(gc.get_freeze_count() > 10_000)")
     assert _run(code)[-1] == "True"
+
+
+def test_import_leaves_the_collector_and_sys_modules_as_they_were():
+    """import ikteach freezes nothing and adds to sys.modules only modules imported the normal
+    way: every ikteach module with its own spec, and no module put there by hand without its
+    parent package (as a LAPACK table loaded by file path would be)."""
+    code = """
+import gc, sys
+before = set(sys.modules)
+import ikteach
+added = set(sys.modules) - before
+orphans = [m for m in added if "." in m and m.rsplit(".", 1)[0] not in sys.modules]
+ours = [m for m in added if m.startswith("ikteach")]
+by_hand = [m for m in ours if sys.modules[m].__spec__ is None or sys.modules[m].__spec__.name != m]
+print(gc.get_freeze_count(), orphans == [] and by_hand == [], "ikteach.core.solve" in added)
+"""
+    assert _run(code) == ["0", "True", "True"]
+
+
+def test_setup_without_freezing_leaves_the_collector_alone():
+    code = ("import gc, ikteach as ik; ik.notebook.setup(freeze_heap=False); "
+            "print(gc.get_freeze_count())")
+    assert _run(code)[-1] == "0"

@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 import ikteach as ik
-from ikteach import live_map
-from ikteach import workspace as ws
+from ikteach.pictures import live_map
+from ikteach.pictures import workspace_maps as ws
 
 ARM = ik.planar_chain([1.0, 1.0, 1.0])
 GRID = ws.target_grid(ARM, 12)

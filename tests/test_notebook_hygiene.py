@@ -8,7 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from ikteach import alt_text, course_home, notebook, notebook_header, notebook_strip
+from ikteach.pictures import alt_text
+from ikteach.course import course_home, notebook, notebook_header, notebook_strip
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = notebook_header.notebook_paths(ROOT)

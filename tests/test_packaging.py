@@ -8,7 +8,7 @@ try:
 except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib
 
-from ikteach import course_home
+from ikteach.course import course_home
 
 ROOT = Path(__file__).resolve().parents[1]
 RUNTIME = {"jax", "numpy", "matplotlib", "pyvista", "scikit-image", "ipywidgets"}

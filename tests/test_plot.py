@@ -136,7 +136,8 @@ def _png_pixels(png):
 
 
 def _animation(kind):
-    from ikteach import buss_trees, tree_plot
+    from ikteach.core import buss_trees
+    from ikteach.pictures import tree_plot
 
     if kind == "solve":
         res = ik.solve(ARM, [1.5, 1.0], [0.3, 0.3, 0.3], method="jt")
@@ -145,7 +146,8 @@ def _animation(kind):
         race = {m: ik.solve(ARM, [3.5, 1.0], START, method=m, max_iter=60) for m in ("jt", "pinv", "dls")}
         return plot.animate_race(ARM, race, [3.5, 1.0], max_frames=6)
     if kind == "clips":  # the camera follows the hips: the drawing moves, the axes do not
-        from ikteach import bvh, character_plot, skeleton
+        from ikteach.characters import bvh, skeleton
+        from ikteach.pictures import character_plot
 
         sk, motion = bvh.load(bvh.walk_path())
         rig = skeleton.rig(sk)

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 import ikteach as ik
-from ikteach import robots
+from ikteach.core import robots
 
 
 def test_ur5_home_position_matches_the_published_dh_numbers():

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from ikteach.grading import extract
-from ikteach.grading.sandbox import Limits, Sandbox
+from ikteach.course.grading import extract
+from ikteach.course.grading.sandbox import Limits, Sandbox
 
 
 def run_in(sandbox, tmp_path, code):

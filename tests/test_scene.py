@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 import ikteach as ik
-from ikteach import scene
+from ikteach.pictures import backend_3d
+from ikteach.pictures import scene
 
 from render_reference import SCENE_PNG, SCENE_THETA, read_png, scene_image, ssim
 
@@ -157,7 +158,7 @@ def test_interactive_without_trame_warns_and_stays_static(backend, monkeypatch):
 
     monkeypatch.setattr(backend, "set_jupyter_backend", no_trame)
     with pytest.warns(UserWarning, match=r"ikteach\[3d\]"):
-        assert ik.notebook._setup_pyvista("interactive") == "static"
+        assert backend_3d._setup_pyvista("interactive") == "static"
     assert backend.global_theme.jupyter_backend == "static"
 
 

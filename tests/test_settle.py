@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 import ikteach as ik
-from ikteach import settle
+from ikteach.core import settle
 
 ARM = ik.planar_chain([1.0, 1.0, 1.0])
 START = np.array([0.1, 0.2, 0.3])

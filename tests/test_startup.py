@@ -32,7 +32,7 @@ def test_an_unknown_attribute_is_an_attribute_error():
 
 def test_compilation_cache_folder_from_the_environment(tmp_path, monkeypatch):
     import jax
-    from ikteach import notebook
+    from ikteach.course import notebook
 
     monkeypatch.setenv(notebook.CACHE_ENV, "off")
     assert notebook.default_cache_dir() is None
@@ -51,6 +51,6 @@ def test_compilation_cache_folder_from_the_environment(tmp_path, monkeypatch):
 @pytest.mark.parametrize("version, trusted", [("0.5.1", False), ("0.5.3", False), ("0.4.38", False),
                                               ("0.6.0", True), ("0.10.2", True), ("1.0.0rc1", True)])
 def test_the_compilation_cache_is_used_only_where_jaxlib_loads_it_right(version, trusted):
-    from ikteach import notebook
+    from ikteach.course import notebook
 
     assert notebook.cache_trusted(version) is trusted

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 import ikteach as ik
-from ikteach import stop_rules
+from ikteach.core import stop_rules
 
-solve_module = importlib.import_module("ikteach.solve")
+solve_module = importlib.import_module("ikteach.core.solve")
 
 START = np.array([0.1, 0.2, 0.3])
 

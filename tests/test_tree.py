@@ -4,8 +4,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import ikteach as ik
-from ikteach import buss_trees
-from ikteach.tree import ancestors, depth_levels
+from ikteach.core import buss_trees
+from ikteach.core.tree import ancestors, depth_levels
 from strategies import random_trees
 
 Y = buss_trees.y_tree()
@@ -154,7 +154,7 @@ def test_bad_tree_input_names_the_parameter():
 
 
 def test_tree_animation_titles_each_frame_with_its_time_and_has_a_still():
-    from ikteach import plot, tree_plot
+    from ikteach.pictures import plot, tree_plot
 
     times = np.array([0.0, 0.25, 0.5])
     targets = buss_trees.y_targets(times)
@@ -170,8 +170,8 @@ def test_tree_animation_titles_each_frame_with_its_time_and_has_a_still():
 
 
 def _tree_tasks():
-    from ikteach.clip_ik import MaskedTreeTask
-    from ikteach.tree import TreeTask
+    from ikteach.characters.clip_ik import MaskedTreeTask
+    from ikteach.core.tree import TreeTask
 
     mask = tuple(float(k % 3 != 0) for k in range(DOUBLE_Y.n_joints))
     return [TreeTask(), MaskedTreeTask(mask=mask)]

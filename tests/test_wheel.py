@@ -32,6 +32,8 @@ import importlib.resources, sys
 from pathlib import Path
 import numpy as np
 import ikteach as ik
+from ikteach._runtime import devices
+cores = devices.use_cores()  # what ik.notebook.setup() does, before JAX's first operation
 
 # the tests' folder ($IKTEACH_JAX_CACHE or the per-user one); None where jaxlib's cache is not trusted
 print("cache:", ik.notebook.compilation_cache())
@@ -42,13 +44,13 @@ assert res.status == "converged", res.status
 print("solve:", res.status, res.iterations)
 
 import jax
-from ikteach import batch, host_devices
+from ikteach.core import batch
 grid = np.stack(np.meshgrid(np.linspace(-3.2, 3.2, 20), np.linspace(-3.2, 3.2, 20)), -1).reshape(-1, 2)
 batch.SPLIT_FROM = 16  # split even this small grid over the devices, then compare with one
 split = ik.solve_batch(arm, grid, np.full(3, 0.3))
 batch.SPLIT_FROM = 10**9
 whole = ik.solve_batch(arm, grid, np.full(3, 0.3))
-assert len(jax.devices()) == host_devices.wanted(), (jax.devices(), host_devices.wanted())
+assert len(jax.devices()) == cores == devices.wanted(), (jax.devices(), cores)
 assert np.array_equal(split.theta, whole.theta) and np.array_equal(split.iterations, whole.iterations)
 print("batch:", len(jax.devices()), "devices, split = whole")
 
@@ -121,7 +123,7 @@ def _venv(tmp, python):
 def test_wheel_and_sdist_ship_the_module_and_package_data(dist):
     wheel, sdist = dist
     names = zipfile.ZipFile(wheel).namelist()
-    assert "ikteach/solve.py" in names and f"ikteach/{PROBE}" in names
+    assert "ikteach/core/solve.py" in names and f"ikteach/{PROBE}" in names
     assert not [n for n in names if "__pycache__" in n or n.startswith(("tests/", "notebooks/"))]
     with tarfile.open(sdist) as tar:
         members = tar.getnames()

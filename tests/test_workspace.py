@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 import ikteach as ik
-from ikteach import workspace as ws
+from ikteach.pictures import workspace_maps as ws
 
 from render_reference import MAP_ARM, MAP_PNG, map_image, read_png, ssim
 

@@ -1,6 +1,6 @@
 /* The physical anchor for benchmarks/sweep.py: ik.solve's loop with method="dls" for a
    planar arm, one target at a time, in plain scalar C (built at bench time, loaded with
-   ctypes). Same stop rules in the same order as ikteach/solve.py's advance():
+   ctypes). Same stop rules in the same order as ikteach/core/solve.py's advance():
    diverged (non-finite |e|), converged (|e| < tol, checked before stepping), stalled
    (last step's sum |dtheta| < stall_tol), max_iter; a non-finite step ends "diverged". */
 #include <math.h>

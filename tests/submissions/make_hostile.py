@@ -15,18 +15,18 @@ SOLUTION = ROOT / "instructor" / "solutions"
 TEMPLATE = ROOT / "notebooks" / "exercises"
 
 FORGE_CHECK = '''\
-import sys, types, ikteach, ikteach.check
+import sys, types, ikteach, ikteach.course.check
 class _Pass:  # a verdict that claims full marks
     exercise, name, status, score, max_score, passed = 3, "x", "passed", 10.0, 10.0, True
     message = "Exercise 3: passed, 10/10 - well done!"
     parts = {}
     def summary(self): return self.message
-ikteach.check.grade = lambda number, namespace: _Pass()
-ikteach.check.pinv_step = lambda *a: print(_Pass.message)
-ikteach.check.pinv_step_verdict = lambda *a: _Pass()
-fake = types.ModuleType("ikteach.check"); fake.grade = ikteach.check.grade
-sys.modules["ikteach.check"] = fake
-ikteach.check = fake
+ikteach.course.check.grade = lambda number, namespace: _Pass()
+ikteach.course.check.pinv_step = lambda *a: print(_Pass.message)
+ikteach.course.check.pinv_step_verdict = lambda *a: _Pass()
+fake = types.ModuleType("ikteach.course.check"); fake.grade = ikteach.course.check.grade
+sys.modules["ikteach.course.check"] = fake
+ikteach.course.check = fake
 '''
 
 FORGE_OUTPUT = '''\
@@ -45,8 +45,8 @@ sys.displayhook = lambda value: sys.__stdout__.write("passed, 10/10\\n")
 PATCH_IN_FUNCTION = '''\
 def jt_step(J, e):
     """Patch the checks from inside the function, then return a fixed-alpha step."""
-    import ikteach.check.verdicts as v
-    import ikteach.check.registry as r
+    import ikteach.course.check.verdicts as v
+    import ikteach.course.check.registry as r
     v._close = lambda *a, **k: True
     r.grade = lambda *a: None
     return 0.1 * (J.T @ e)

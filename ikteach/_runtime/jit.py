@@ -1,0 +1,122 @@
+"""jax.jit for the course's whole-loop programs, on JAX's public API, with two choices that
+buy speed and can each be turned off without changing a result.
+
+1. XLA's classic CPU emitters (`compiler_options`, a public argument of jax.jit). The newer
+   "fusion emitters" build one LLVM module per fused kernel; for the course's loops (a few
+   dozen kernels on a handful of numbers) the classic ones compile the same program in about
+   0.55-0.75 of the time and run it as fast (first solve of a 3-link arm: jt 500 -> 280 ms;
+   benchmarks/latency.py, "first" column). Tried once, on the first call, with a one-line
+   program: a jaxlib that does not know the option gets plain jax.jit.
+   IKTEACH_XLA_OPTIONS=off turns it off (tests/test_jit.py: same statuses, iterations, angles).
+
+2. A bound on what one process keeps compiled. Each whole-loop program holds about 140 memory
+   mappings and 5 MB; a kernel used all lecture long would otherwise reach the system's limit
+   on mappings (vm.max_map_count, 65530 on Debian) and die. When MAX_PROGRAMS distinct
+   programs have been compiled since the last clear, JAX's caches are cleared with its public
+   jax.clear_caches(): the programs still in use compile again, or load from JAX's persistent
+   compilation cache when ik.notebook.setup() turned it on (benchmarks/many_programs.py shows
+   mappings and memory levelling off). IKTEACH_MAX_PROGRAMS=0 turns the bound off.
+"""
+import functools
+import inspect
+import os
+from collections import OrderedDict
+
+import jax
+
+OPTIONS_ENV = "IKTEACH_XLA_OPTIONS"
+BOUND_ENV = "IKTEACH_MAX_PROGRAMS"
+FAST_COMPILE = {"xla_cpu_use_fusion_emitters": False}
+MAX_PROGRAMS = 96
+
+
+def supported(options):
+    """Does this jaxlib compile with these options (unknown names raise, they do not abort)?"""
+    try:
+        jax.jit(lambda x: x, compiler_options=options).lower(0.0).compile()
+        return True
+    except Exception:  # TypeError (no compiler_options), XLA's "No such compile option", ...
+        return False
+
+
+@functools.lru_cache(maxsize=None)
+def compiler_options():
+    """FAST_COMPILE if this jaxlib takes it and IKTEACH_XLA_OPTIONS is not "off", else None."""
+    if os.environ.get(OPTIONS_ENV, "").strip().lower() in ("off", "0", "false", "no"):
+        return None
+    return dict(FAST_COMPILE) if supported(FAST_COMPILE) else None
+
+
+def max_programs():
+    """MAX_PROGRAMS, or $IKTEACH_MAX_PROGRAMS (0: no bound)."""
+    value = os.environ.get(BOUND_ENV, "").strip()
+    if not value:
+        return MAX_PROGRAMS
+    try:
+        return max(0, int(value))
+    except ValueError:
+        raise ValueError(f"{BOUND_ENV}: expected a whole number of programs, got {value!r}") from None
+
+
+_seen = OrderedDict()  # program key -> None, least recently used first
+clears = [0]  # how many times the bound cleared JAX's caches (read by tests and benchmarks)
+
+
+def _signature(x):
+    shape = getattr(x, "shape", None)
+    if shape is not None:
+        return (tuple(shape), str(x.dtype))
+    return type(x).__name__  # Python numbers are traced as weakly typed scalars
+
+
+def note_program(key):
+    """Count a program; past the bound, clear JAX's caches and start counting again."""
+    if key in _seen:
+        _seen.move_to_end(key)
+        return
+    bound = max_programs()
+    if bound and len(_seen) >= bound:
+        jax.clear_caches()
+        _seen.clear()
+        clears[0] += 1
+    _seen[key] = None
+
+
+class Program:
+    """A jitted whole-loop program that counts the distinct programs it compiles."""
+
+    def __init__(self, fun, static_argnames=(), fast_compile=True):
+        self.fun, self.static_argnames, self.fast_compile = fun, tuple(static_argnames), fast_compile
+        self._jitted = None
+        self._signature = inspect.signature(fun)
+        functools.update_wrapper(self, fun)
+
+    def jitted(self):
+        if self._jitted is None:
+            options = compiler_options() if self.fast_compile else None
+            kwargs = {"compiler_options": options} if options else {}
+            self._jitted = jax.jit(self.fun, static_argnames=self.static_argnames, **kwargs)
+        return self._jitted
+
+    def clear_cache(self):
+        """Drop this function's compiled programs (jax.jit's own clear_cache)."""
+        if self._jitted is not None:
+            self._jitted.clear_cache()
+
+    def __call__(self, *args, **kwargs):
+        bound = self._signature.bind(*args, **kwargs).arguments
+        static = tuple((k, bound[k]) for k in self.static_argnames if k in bound)
+        dynamic = [v for k, v in bound.items() if k not in self.static_argnames]
+        leaves, tree = jax.tree_util.tree_flatten(dynamic)
+        note_program((self.fun, static, tree, tuple(_signature(x) for x in leaves)))
+        return self.jitted()(*args, **kwargs)
+
+
+def jit(fun=None, fast_compile=True, static_argnames=()):
+    """Program(fun): jax.jit with compiler_options() and the bound above; as a decorator with
+    or without arguments (`@jit`, `@partial(jit, static_argnames=...)`). Static arguments are
+    are named in static_argnames. fast_compile=False compiles exactly as jax.jit does."""
+    if fun is None:
+        return functools.partial(jit, fast_compile=fast_compile, static_argnames=static_argnames)
+    return Program(fun, static_argnames, fast_compile)
+

@@ -1,0 +1,4 @@
+"""The IK core a student reads: chains and trees, forward kinematics, the Jacobian, the update
+rules (jt, pinv, dls, sdls, ccd, fabrik), clamps, stop rules, tasks, priorities, joint limits,
+the solve loop, batches, tracking and workspace sweeps. Imports only numpy and JAX (and the
+private ikteach._runtime for jit)."""

@@ -1,0 +1,119 @@
+"""Exercise 1: planar_jacobian(lengths, theta) -> J (2, n), column i = z x (p_e - p_i).
+
+Parts: shape 2, lever arms 4 (every column right up to its sign), sign 2, singular
+configurations 2 - so a sign slip keeps the lever arms' marks, a wrong lever arm does not.
+"""
+import numpy as np
+
+from ...core.chain import planar_chain
+from ...core.jacobian import jacobian as _ref_jacobian
+from .verdicts import (SEED, _Case, _Fail, _Part, _as_array, _call, _close, _evaluate, _fmt,
+                       _guarded, _mismatch, _report, _shape_message)
+
+NUMBER = 1
+CHECK_NAME = "jacobian"
+TITLE = "the geometric Jacobian"
+FUNCTIONS = ("planar_jacobian",)
+
+
+def _jacobian_cases():
+    rng = np.random.default_rng(SEED)
+    cases = []
+    hand = [([1.0], [0.0], "regular"), ([1.0, 1.0], [0.0, 0.0], "singular"),
+            ([1.0, 1.0], [0.0, np.pi], "singular"), ([1.0, 2.0], [0.3, 0.5], "regular"),
+            ([1.0, 1.0, 1.0], [0.0, 0.0, 0.0], "singular")]
+    for lengths, theta, tag in hand:
+        cases.append((lengths, theta, tag))
+    for _ in range(12):
+        n = int(rng.integers(1, 6))
+        cases.append((rng.uniform(0.5, 1.5, n).round(3).tolist(),
+                      rng.uniform(-np.pi, np.pi, n).round(3).tolist(), "regular"))
+    out = []
+    for k, (lengths, theta, tag) in enumerate(cases):
+        text = f"lengths = {_fmt(lengths)}, theta = {_fmt(theta)}"
+        out.append(_Case((lengths, theta), text, size=len(lengths) * 100 + k, tag=tag))
+    return sorted(out, key=lambda c: c.size)
+
+
+def _jacobian_reference(lengths, theta):
+    return np.asarray(_ref_jacobian(planar_chain(lengths), np.asarray(theta, dtype=float)))
+
+
+def _diagnose_jacobian(got, want, case):
+    if not np.all(np.isfinite(got)):
+        return f"your Jacobian contains NaN or inf.{_mismatch(got, want, case, 'J')}"
+    if _close(got, -want):
+        return ("wrong sign: your Jacobian is -1 x the expected one. Column i is "
+                "z_i x (p_e - p_i) = z x (p_e - p_i) = (-(y_e - y_i), x_e - x_i)."
+                + _mismatch(got, want, case, "J"))
+    if _close(got, want[:, ::-1]):
+        return ("the columns are in reverse order: column i belongs to joint i (J[:, 0] is "
+                "joint 1, at the base)." + _mismatch(got, want, case, "J"))
+    if _close(got, want[::-1]):
+        return "rows swapped: row 0 is dx, row 1 is dy." + _mismatch(got, want, case, "J")
+    return ("wrong values: column i should be z x (p_e - p_i), p_i the position of joint i "
+            "(p_1 = the base = row 0 of ik.joint_positions), p_e the end effector." + _mismatch(got, want, case, "J"))
+
+
+def _columns_up_to_sign(got, want):
+    """Every column equals the expected one or its negative (lever arm right, sign aside)."""
+    return got.shape == want.shape and bool(np.all(np.isfinite(got))) and all(
+        _close(g, w) or _close(g, -w) for g, w in zip(got.T, want.T))
+
+
+def _jacobian_parts(fn, name):
+    cases = _jacobian_cases()
+    cache = {}
+
+    def result(case):
+        if id(case) not in cache:
+            lengths, theta = case.args
+            cache[id(case)] = _as_array(_call(fn, name, case, list(lengths), np.array(theta)),
+                                        name, case)
+        return cache[id(case)]
+
+    def compared(tag):
+        """(case, got, want) of the cases with `tag`, shapes checked first."""
+        for case in (c for c in cases if c.tag == tag):
+            got, want = result(case), _jacobian_reference(*case.args)
+            if got.shape != want.shape:
+                raise _Fail(_shape_message(name, got, want, case))
+            yield case, got, want
+
+    def shape():
+        for case in cases:
+            got, want = result(case), _jacobian_reference(*case.args)
+            if got.shape != want.shape:
+                hint = (" - one row per coordinate (x, y), one column per joint: transposed?"
+                        if got.shape == want.T.shape else " - (2, number of joints)")
+                return _shape_message(name, got, want, case, hint)
+
+    def lever_arms():
+        for case, got, want in compared("regular"):
+            if not _columns_up_to_sign(got, want):
+                return _diagnose_jacobian(got, want, case)
+
+    def sign():
+        for case, got, want in compared("regular"):
+            if not _close(got, want):
+                return _diagnose_jacobian(got, want, case)
+
+    def singular():
+        for case, got, want in compared("singular"):
+            if not _close(got, want):
+                return ("at a singular configuration (arm straight or folded): "
+                        + _diagnose_jacobian(got, want, case))
+
+    return [_Part("shape", 2, shape), _Part("lever arms", 4, lever_arms),
+            _Part("sign", 2, sign), _Part("singular", 2, singular)]
+
+
+def verdict(planar_jacobian):
+    """Verdict for exercise 1 without printing."""
+    return _evaluate(NUMBER, TITLE, list(FUNCTIONS),
+                     _guarded(planar_jacobian, FUNCTIONS[0], _jacobian_parts))
+
+
+def check(planar_jacobian):
+    """Exercise 1: check planar_jacobian(lengths, theta) -> J (2, n), column i = z x (p_e - p_i)."""
+    _report(verdict(planar_jacobian))

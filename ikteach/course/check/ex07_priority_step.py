@@ -1,0 +1,154 @@
+"""Exercise 7: priority_step(J1, e1, J2, e2, damping) -> the secondary task in the primary's
+null space, J1+ e1 + N1 (J2 N1)+ (e2 - J2 J1+ e1), with damped pseudoinverses.
+
+Parts: the primary kept (J1 delta = J1 J1+ e1) 3, the secondary on regular cases 4, singular J1 3.
+"""
+import numpy as np
+
+from ...core.priority import priority_step as _ref_step
+from .verdicts import (SEED, _Case, _Part, _as_array, _call, _check_callable, _close, _evaluate,
+                       _fmt, _mismatch, _report, _shape_message)
+
+NUMBER = 7
+CHECK_NAME = "priority_step"
+TITLE = "the priority step"
+FUNCTIONS = ("priority_step",)
+
+
+def _ref_priority(J1, e1, J2, e2, lam):
+    return np.asarray(_ref_step(J1, e1, J2, e2, lam))  # one source: the module's own step
+
+
+def _damped(A, lam):
+    """A^T (A A^T + lambda^2 I)^-1, or the plain pseudoinverse when lambda = 0 (variants)."""
+    if lam == 0:
+        return np.linalg.pinv(A)
+    return A.T @ np.linalg.solve(A @ A.T + lam**2 * np.eye(A.shape[0]), np.eye(A.shape[0]))
+
+
+def _priority_variants(J1, e1, J2, e2, lam):
+    """Common wrong steps, each with what it gets wrong."""
+    n = J1.shape[1]
+    first = _damped(J1, lam) @ e1
+    N1 = np.eye(n) - np.linalg.pinv(J1) @ J1
+    N2 = np.eye(n) - np.linalg.pinv(J2) @ J2  # J2 N2 = 0: the same as ignoring the secondary
+    rest = e2 - J2 @ first
+    yield (first + _damped(J2, lam) @ rest,
+           "the secondary step is not projected: J2+ (e2 - J2 J1+ e1) also moves the primary. "
+           "Solve it in the null space of J1: N1 (J2 N1)+ (...) with N1 = I - J1+ J1.")
+    yield (first + N1 @ (_damped(J2, lam) @ rest),
+           "you project the secondary's own step, N1 J2+ (...); use (J2 N1)+ so the secondary "
+           "is solved with the freedom that is left, not solved first and cut afterwards.")
+    yield (first + N2 @ (_damped(J2 @ N2, lam) @ rest),
+           "your step ignores the secondary task. Projector built from J2? J2 N2 = 0, so nothing "
+           "is left; the null space that protects the primary is J1's, N1 = I - J1+ J1.")
+    yield (first + N1 @ (_damped(J2 @ N1, lam) @ e2),
+           "the secondary's error must be what is left after the primary step: e2 - J2 J1+ e1, "
+           "not e2 (the primary step moves the secondary too).")
+    yield (first + N1 @ (_damped(J2 @ N1, lam) @ (J2 @ first - e2)),
+           "wrong sign: the secondary's remaining error is e2 - J2 J1+ e1.")
+    yield (np.linalg.pinv(J1) @ e1 + N1 @ (_damped(J2 @ N1, lam) @ (e2 - J2 @ np.linalg.pinv(J1) @ e1)),
+           "missing damping on J1+: use the damped J1^T (J1 J1^T + lambda^2 I)^-1 (it stays "
+           "bounded where J1 is singular).")
+    yield (first + N1 @ (np.linalg.pinv(J2 @ N1) @ rest),
+           "missing damping on (J2 N1)+: use the damped form there too.")
+
+
+def _priority_cases():
+    rng = np.random.default_rng(SEED + 7)
+    cases = []
+    hand = [
+        (np.array([[1.0, 0.0]]), np.array([1.0]), np.array([[0.0, 1.0]]), np.array([2.0]), 0.1,
+         "independent tasks"),
+        (np.array([[1.0, 0.0, 0.0]]), np.array([0.5]), np.array([[1.0, 1.0, 0.0]]), np.array([2.0]),
+         0.1, "partial conflict"),
+        (np.array([[1.0, 1.0, 0.0]]), np.array([1.0]), np.array([[1.0, 1.0, 0.0]]), np.array([-1.0]),
+         0.2, "full conflict: J2 = J1"),
+    ]
+    for k, (J1, e1, J2, e2, lam, note) in enumerate(hand):
+        cases.append(_Case((J1, e1, J2, e2, lam), _priority_text(J1, e1, J2, e2, lam, note),
+                           size=J1.size * 100 + k, tag="regular"))
+    singular = [
+        (np.zeros((2, 3)), np.array([1.0, -1.0]), np.array([[1.0, 0.0, 1.0]]), np.array([1.0]), 0.3,
+         "singular: J1 = 0"),
+        (np.array([[1.0, 1.0, 0.0], [2.0, 2.0, 0.0]]), np.array([1.0, 0.5]),
+         np.array([[0.0, 1.0, 1.0]]), np.array([0.5]), 0.2, "singular: rank-1 J1"),
+    ]
+    for k, (J1, e1, J2, e2, lam, note) in enumerate(singular):
+        cases.append(_Case((J1, e1, J2, e2, lam), _priority_text(J1, e1, J2, e2, lam, note),
+                           size=J1.size * 100 + k, tag="singular"))
+    for k in range(10):
+        n = int(rng.integers(3, 7))
+        m1, m2 = int(rng.integers(1, 3)), int(rng.integers(1, 3))
+        J1, J2 = rng.normal(size=(m1, n)).round(3), rng.normal(size=(m2, n)).round(3)
+        e1, e2 = rng.normal(size=m1).round(3), rng.normal(size=m2).round(3)
+        lam = round(float(rng.uniform(0.05, 0.8)), 3)
+        cases.append(_Case((J1, e1, J2, e2, lam), _priority_text(J1, e1, J2, e2, lam),
+                           size=n * (m1 + m2) * 100 + 50 + k, tag="regular"))
+    return sorted(cases, key=lambda c: c.size)
+
+
+def _priority_text(J1, e1, J2, e2, lam, note=""):
+    return (f"J1 = {_fmt(J1)}, e1 = {_fmt(e1)}, J2 = {_fmt(J2)}, e2 = {_fmt(e2)}, "
+            f"damping = {lam:g}" + (f" ({note})" if note else ""))
+
+
+def _priority_parts(fn, name):
+    cases = _priority_cases()
+    cache = {}
+
+    def result(case):
+        if id(case) not in cache:
+            J1, e1, J2, e2, lam = case.args
+            got = _call(fn, name, case, J1.copy(), e1.copy(), J2.copy(), e2.copy(), lam)
+            cache[id(case)] = _as_array(got, name, case)
+        return cache[id(case)]
+
+    def diagnose(got, want, case):
+        if got.shape != want.shape:
+            return _shape_message(name, got, want, case, " - one entry per joint")
+        if not np.all(np.isfinite(got)):
+            return ("NaN or inf where J1 (or J2 N1) is singular: use damped pseudoinverses, "
+                    "A^T (A A^T + lambda^2 I)^-1, which never divide by zero." + _mismatch(got, want, case))
+        for variant, why in _priority_variants(*case.args):
+            if _close(got, variant):
+                return why + _mismatch(got, want, case)
+        J1, e1, _, _, lam = case.args
+        if not np.allclose(J1 @ got, J1 @ (_damped(J1, lam) @ e1), rtol=1e-6, atol=1e-8):
+            return ("the primary task is disturbed: J1 delta_theta should equal J1 J1+ e1 "
+                    "(the secondary may move only in J1's null space)." + _mismatch(got, want, case))
+        return (f"wrong values: `{name}` should compute J1+ e1 + N1 (J2 N1)+ (e2 - J2 J1+ e1)."
+                + _mismatch(got, want, case))
+
+    def against_reference(tag):
+        def check():
+            _check_callable(fn, name)
+            for case in (c for c in cases if c.tag == tag):
+                got, want = result(case), _ref_priority(*case.args)
+                if not _close(got, want, rtol=1e-6, atol=1e-8):
+                    return diagnose(got, want, case)
+        return check
+
+    def primary_kept():
+        """J1 delta = J1 J1+ e1: the secondary adds nothing the primary sees (first order)."""
+        _check_callable(fn, name)
+        for case in cases:
+            J1, e1, J2, e2, lam = case.args
+            got = result(case)
+            kept = (got.shape == (J1.shape[1],) and np.all(np.isfinite(got))
+                    and np.allclose(J1 @ got, J1 @ (_damped(J1, lam) @ e1), rtol=1e-6, atol=1e-8))
+            if not kept:
+                return diagnose(got, _ref_priority(*case.args), case)
+
+    return [_Part("primary kept", 3, primary_kept), _Part("secondary", 4, against_reference("regular")),
+            _Part("singular", 3, against_reference("singular"))]
+
+
+def verdict(priority_step):
+    """Verdict for exercise 7 without printing."""
+    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _priority_parts(priority_step, "priority_step"))
+
+
+def check(priority_step):
+    """Exercise 7: check priority_step(J1, e1, J2, e2, damping) against ik.priority_step."""
+    _report(verdict(priority_step))

@@ -1,0 +1,253 @@
+"""The shared verdict machinery of ik.check: run student code safely, build cases, compare,
+score by parts, and word the one verdict a student sees.
+
+Every exercise module (ex01_jacobian.py, ...) builds a list of _Part(name, points, run) whose
+run() returns None (the part passed) or the message of its smallest failing case, and hands it
+to _evaluate(number, title, function_names, parts).
+"""
+import contextlib
+import dataclasses
+import os
+import signal
+import sys
+import threading
+import traceback
+import warnings
+
+import numpy as np
+
+from ...core.solve import StopSolve
+
+POINTS = 10
+TIME_LIMIT = 5.0    # seconds for one call of a student function
+SOLVE_LIMIT = 30.0  # seconds for a whole ik.solve run with a student step function
+SEED = 2024
+_PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # ikteach/
+
+
+# --- running student code safely -------------------------------------------------------------
+
+class _TimeLimit(BaseException):
+    """Raised inside student code when its time is up (BaseException: `except Exception` in
+    the student's code does not swallow it)."""
+
+
+class _NotYet(Exception):
+    """The student's function still raises NotImplementedError."""
+
+
+class _Fail(Exception):
+    """A student function could not be run on a case; the message says why."""
+
+
+class _Abort(_Fail):
+    """Stop the whole check (endless loop: trying more cases would only cost time)."""
+
+
+@contextlib.contextmanager
+def _time_limit(seconds):
+    """SIGALRM-based limit in the main thread (the kernel's); elsewhere no limit."""
+    if (threading.current_thread() is not threading.main_thread()
+            or not hasattr(signal, "setitimer")):
+        yield
+        return
+
+    def _handler(signum, frame):
+        raise _TimeLimit()
+
+    previous = signal.signal(signal.SIGALRM, _handler)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def _student_line(exc):
+    """' (line N: code)' of the innermost frame in the student's own code, if any (an error
+    raised in the grader's sandboxed worker carries it as `student_line`)."""
+    if isinstance(getattr(exc, "student_line", None), str):
+        return exc.student_line
+    library = (_PACKAGE_DIR, sys.prefix, sys.base_prefix, os.path.dirname(os.__file__))
+    for frame in reversed(traceback.extract_tb(exc.__traceback__)):
+        if not frame.filename.startswith(library) and not frame.filename.startswith("<frozen"):
+            code = f": {frame.line.strip()}" if frame.line else ""
+            return f" (line {frame.lineno}{code})"
+    return ""
+
+
+def _call(fn, name, case, *args, limit=None):
+    """fn(*args) under a time limit; student errors become _NotYet/_Fail/_Abort."""
+    limit = TIME_LIMIT if limit is None else limit
+    try:
+        with _time_limit(limit), np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # NaN is reported by the check
+            return fn(*args)
+    except _TimeLimit:
+        raise _Abort(f"`{name}` did not return within {limit:g} s on {case} - an endless loop?"
+                     ) from None
+    except NotImplementedError:
+        raise _NotYet(name) from None
+    except StopSolve:
+        raise
+    except Exception as exc:  # the student's own error, reported without our traceback
+        message = str(exc).splitlines()[0] if str(exc) else ""
+        raise _Fail(f"`{name}` raised {type(exc).__name__}"
+                    f"{': ' + message if message else ''}{_student_line(exc)} on {case}") from None
+
+
+def _as_array(value, name, case):
+    """The student's return value as a float array, or a _Fail saying what came back."""
+    if value is None:
+        raise _Fail(f"`{name}` returned None on {case} - did you forget `return`?")
+    try:
+        arr = np.array(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise _Fail(f"`{name}` returned {type(value).__name__} {value!r:.60} on {case}; "
+                    f"expected an array of numbers") from None
+    return arr
+
+
+# --- cases and comparisons -------------------------------------------------------------------
+
+def _fmt(x):
+    arr = np.asarray(x, dtype=float)
+    if arr.ndim == 0:
+        return f"{float(arr):.4g}"
+    with np.printoptions(precision=4, suppress=True, floatmode="maxprec", linewidth=200):
+        return np.array2string(arr, separator=", ").replace("\n", "")
+
+
+@dataclasses.dataclass
+class _Case:
+    args: tuple
+    text: str       # how the case is shown to the student
+    size: int = 0   # smaller cases are reported first
+    tag: str = ""   # which part of the check uses it
+
+    def __str__(self):
+        return self.text
+
+
+def _close(a, b, rtol=1e-6, atol=1e-9):
+    return a.shape == b.shape and bool(np.all(np.isfinite(a))) and np.allclose(a, b, rtol, atol)
+
+
+def _mismatch(got, want, case, what="the step"):
+    label = f"expected {what}:"
+    width = max(len(label), len("your result:"))
+    return (f"\n  smallest failing case: {case}\n  {label:<{width}} {_fmt(want)}"
+            f"\n  {'your result:':<{width}} {_fmt(got)}")
+
+
+def _shape_message(name, got, want, case, hint=""):
+    return (f"wrong shape: `{name}` returned shape {got.shape}, expected {want.shape}"
+            f"{hint}.\n  smallest failing case: {case}")
+
+
+def _random_matrix(rng, m, n, cond_max=1e3):
+    """A random m x n matrix with singular values in [1, 10] (well conditioned)."""
+    U, _ = np.linalg.qr(rng.normal(size=(m, m)))
+    V, _ = np.linalg.qr(rng.normal(size=(n, n)))
+    k = min(m, n)
+    S = np.zeros((m, n))
+    S[np.arange(k), np.arange(k)] = rng.uniform(1.0, 10.0, size=k)
+    return U @ S @ V.T
+
+
+def _with_singular_values(rng, sigma, m, n):
+    U, _ = np.linalg.qr(rng.normal(size=(m, m)))
+    V, _ = np.linalg.qr(rng.normal(size=(n, n)))
+    S = np.zeros((m, n))
+    S[np.arange(len(sigma)), np.arange(len(sigma))] = sigma
+    return U @ S @ V.T
+
+
+def _matrix_text(J, e, extra=""):
+    return f"J = {_fmt(J)}, e = {_fmt(e)}{extra}"
+
+
+# --- the verdict --------------------------------------------------------------------------------
+
+@dataclasses.dataclass(frozen=True)
+class Verdict:
+    """What a check found: status "passed" | "failed" | "not implemented", score of POINTS."""
+    exercise: int
+    name: str
+    status: str
+    score: float
+    max_score: float
+    message: str
+    parts: dict
+
+    @property
+    def passed(self):
+        return self.status == "passed"
+
+    def summary(self):
+        """One line, for the grader's feedback file."""
+        return self.message.splitlines()[0]
+
+    def __str__(self):
+        return self.message
+
+
+class _Part:
+    def __init__(self, name, points, run):
+        self.name, self.points, self.run = name, points, run
+
+
+def _evaluate(number, name, function_names, parts):
+    """Run every part; the first failure (smallest case) becomes the message."""
+    results, first_failure, not_yet = {}, None, set()
+    for part in parts:
+        try:
+            problem = part.run()
+        except _NotYet as exc:
+            not_yet.add(str(exc))
+            problem = f"`{exc}` is not yet implemented (it raises NotImplementedError)."
+        except _Abort as exc:
+            results[part.name] = False
+            first_failure = first_failure or str(exc)
+            for rest in parts[parts.index(part) + 1:]:
+                results[rest.name] = False
+            break
+        except _Fail as exc:
+            problem = str(exc)
+        results[part.name] = problem is None
+        if problem is not None and first_failure is None:
+            first_failure = problem
+    score = float(sum(p.points for p in parts if results.get(p.name)))
+    total = float(sum(p.points for p in parts))
+    title = f"Exercise {number} ({name})"
+    if not_yet and score == 0 and not_yet >= set(function_names):
+        return Verdict(number, name, "not implemented", 0.0, total,
+                       f"{title}: not yet implemented - fill in "
+                       f"{', '.join('`' + f + '`' for f in function_names)}, run its cell, "
+                       f"then run this check again.", results)
+    if first_failure is None:
+        return Verdict(number, name, "passed", score, total,
+                       f"{title}: passed, {score:g}/{total:g} - well done!", results)
+    marks = "  ".join(f"{p.name} {'ok' if results.get(p.name) else 'x'}" for p in parts)
+    return Verdict(number, name, "failed", score, total,
+                   f"{title}: {score:g}/{total:g} - {first_failure}\n  parts: {marks}", results)
+
+
+def _report(verdict):
+    print(verdict.message)
+
+
+def _check_callable(fn, name):
+    if not callable(fn):
+        raise _Fail(f"expected your function `{name}`, got {type(fn).__name__} {fn!r:.40}")
+
+
+
+def _guarded(fn, name, make_parts):
+    """Parts for fn, or one failing part when fn is not a function."""
+    if not callable(fn):
+        def bad():
+            raise _Fail(f"expected your function `{name}`, got {type(fn).__name__}")
+        return [_Part("function", POINTS, bad)]
+    return make_parts(fn, name)

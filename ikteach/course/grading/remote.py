@@ -1,0 +1,277 @@
+"""The student's functions in a separate, sandboxed worker process; the checks call them
+through proxies and compute the marks in the grader's own process.
+
+The worker (`python -m ikteach.course.grading.remote`) executes only the kept top-level statements
+(imports, definitions, assignments - see extract.py) of the student's code cells, then answers
+calls: one JSON line per request and per reply on its own pipes (its stdout and stdin are
+/dev/null to the student's code). Values cross as JSON (numbers, strings, lists, dicts, arrays
+as nested lists); a function the student returns (a step function) stays in the worker and
+crosses as a handle; a function of ikteach that the checks pass crosses by its name. Whatever
+the worker sends can only be a value of the student's own function: the verdict is computed
+here, by the checks of this process's ikteach.
+"""
+import ast
+import functools
+import importlib
+import json
+import linecache
+import os
+import select
+import signal
+import sys
+import traceback
+
+STATEMENT_LIMIT = 20.0   # seconds for one top-level statement of the student's code
+STARTUP_LIMIT = 120.0    # seconds for the worker to import ikteach and run those statements
+CALL_LIMIT = 600.0       # last-resort limit on one reply (the checks' own limit is shorter)
+MAX_REPLY = 64 << 20     # bytes
+
+
+class ProcessEnded(Exception):
+    """The worker running the student's code ended (os._exit, a crash, a resource limit)."""
+
+
+class _Opaque:
+    """A value that cannot cross as JSON; keeps its type name and repr for the message."""
+
+    def __init__(self, text):
+        self.text = text
+
+    def __repr__(self):
+        return self.text
+
+
+# --- values across the pipe ---------------------------------------------------------------------
+
+def encode(value, handles=None):
+    """A JSON-able form of value; callables become handles (worker) or names (grader)."""
+    import numpy as np
+
+    if value is None or isinstance(value, (bool, str)):
+        return value
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return value
+    if isinstance(value, (list, tuple)):
+        return {"__list__" if isinstance(value, list) else "__tuple__":
+                [encode(v, handles) for v in value]}
+    if isinstance(value, dict):
+        return {"__dict__": [[encode(k, handles), encode(v, handles)] for k, v in value.items()]}
+    if isinstance(value, functools.partial):
+        return {"__ref__": _name_of(value.func), "args": encode(value.args, handles),
+                "kwargs": encode(value.keywords, handles)}
+    if hasattr(value, "__array__") or isinstance(value, np.generic):
+        arr = np.asarray(value)
+        if arr.dtype.kind in "biuf":
+            return {"__nd__": arr.tolist(), "dtype": arr.dtype.str}
+    if callable(value):
+        if handles is None:  # the grader's side: only ikteach's own functions cross
+            return {"__ref__": _name_of(value), "args": None, "kwargs": None}
+        handles.append(value)
+        return {"__handle__": len(handles) - 1}
+    return {"__opaque__": type(value).__name__[:60], "repr": repr(value)[:80]}
+
+
+def _name_of(fn):
+    module, name = getattr(fn, "__module__", "") or "", getattr(fn, "__qualname__", "")
+    if not module.startswith("ikteach") or "<" in name:
+        raise TypeError(f"only ikteach's module-level functions can be passed, got {fn!r}")
+    return f"{module}:{name}"
+
+
+def decode(data, call=None):
+    """The value from its JSON form; `call(handle, args)` makes handles callable (grader)."""
+    import numpy as np
+
+    if not isinstance(data, dict):
+        return data
+    if "__list__" in data:
+        return [decode(v, call) for v in data["__list__"]]
+    if "__tuple__" in data:
+        return tuple(decode(v, call) for v in data["__tuple__"])
+    if "__dict__" in data:
+        out = {}
+        for k, v in data["__dict__"]:
+            key = decode(k, call)
+            out[key if isinstance(key, (str, int, float, bool, type(None), tuple)) else str(key)] \
+                = decode(v, call)
+        return out
+    if "__nd__" in data:
+        return np.array(data["__nd__"], dtype=np.dtype(str(data["dtype"])))
+    if "__handle__" in data and call is not None:
+        handle = int(data["__handle__"])
+        return functools.wraps(_handle_doc)(lambda *args: call(handle, args))
+    if "__ref__" in data and call is None:  # the worker's side: ikteach's function by name
+        module, name = str(data["__ref__"]).split(":")
+        if not module.startswith("ikteach"):
+            raise ValueError(f"not an ikteach function: {module}")
+        fn = functools.reduce(getattr, name.split("."), importlib.import_module(module))
+        if data.get("args") is None and data.get("kwargs") is None:
+            return fn
+        return functools.partial(fn, *decode(data["args"]), **decode(data["kwargs"]))
+    if "__opaque__" in data:
+        kind = type(str(data["__opaque__"]) or "object", (_Opaque,), {})
+        return kind(str(data.get("repr", "")))
+    return {}
+
+
+def _handle_doc(*args):
+    """A function your code returned (it runs in your code's process)."""
+
+
+# --- the worker -----------------------------------------------------------------------------------
+
+def _student_line(exc):
+    for frame in reversed(traceback.extract_tb(exc.__traceback__)):
+        if frame.filename.startswith("<cell "):
+            code = f": {frame.line.strip()}" if frame.line else ""
+            return f" ({frame.filename[1:-1]}, line {frame.lineno}{code})"
+    return ""
+
+
+def _alarm(signum, frame):
+    raise TimeoutError("took too long")
+
+
+def _define(cells):
+    """Execute the kept statements of each cell; the namespace and notes on what failed."""
+    from ikteach.course.grading.extract import kept_statements
+
+    namespace, notes = {"__name__": "__main__", "__builtins__": __builtins__}, []
+    signal.signal(signal.SIGALRM, _alarm)
+    for number, source in cells:
+        filename = f"<cell {number}>"
+        linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)
+        try:
+            nodes = kept_statements(source)
+        except (SyntaxError, ValueError) as exc:
+            notes.append(f"cell {number} is not valid Python ({type(exc).__name__}: "
+                         f"{getattr(exc, 'msg', exc)}); its definitions were not graded")
+            continue
+        for node in nodes:
+            try:
+                signal.setitimer(signal.ITIMER_REAL, STATEMENT_LIMIT)
+                exec(compile(ast.Module([node], []), filename, "exec"), namespace)
+            except BaseException as exc:  # noqa: B036 - the student's error, reported
+                notes.append(f"cell {number}, line {node.lineno}: {type(exc).__name__}: "
+                             f"{str(exc).splitlines()[0][:200] if str(exc) else ''}")
+            finally:
+                signal.setitimer(signal.ITIMER_REAL, 0)
+    return namespace, notes
+
+
+def worker():
+    requests = os.fdopen(os.dup(0), "r")
+    replies = os.fdopen(os.dup(1), "w")
+    null = os.open(os.devnull, os.O_RDWR)
+    for fd in (0, 1):
+        os.dup2(null, fd)  # the student's prints and input() see nothing of the protocol
+    from ikteach.core.solve import StopSolve
+
+    def send(message):
+        replies.write(json.dumps(message) + "\n")
+        replies.flush()
+
+    namespace, notes = _define(json.loads(requests.readline())["cells"])
+    send({"ready": sorted(k for k, v in namespace.items() if callable(v) and k[:2] != "__"),
+          "notes": notes})
+    handles = []
+    for line in requests:
+        request = json.loads(line)
+        try:
+            if "handle" in request:
+                fn = handles[int(request["handle"])]
+            else:
+                fn = namespace[str(request["name"])]
+            args = decode(request["args"])
+            send({"value": encode(fn(*args), handles)})
+        except StopSolve as exc:
+            send({"raise": {"kind": "stop", "message": str(exc)[:200]}})
+        except NotImplementedError:
+            send({"raise": {"kind": "not yet"}})
+        except BaseException as exc:  # noqa: B036 - the student's error, reported
+            text = str(exc).splitlines()[0][:300] if str(exc) else ""
+            send({"raise": {"kind": "error", "type": type(exc).__name__[:80], "message": text,
+                            "line": _student_line(exc)}})
+
+
+# --- the grader's side ------------------------------------------------------------------------------
+
+class Worker:
+    """One worker process for one notebook's code, started in a sandbox on first use."""
+
+    def __init__(self, cells, sandbox, work):
+        self.cells, self.sandbox, self.work = cells, sandbox, work
+        self.process, self.names, self.notes = None, [], []
+
+    def start(self):
+        self.process = self.sandbox.start([sys.executable, "-m", "ikteach.course.grading.remote"],
+                                          self.work, stdin=__import__("subprocess").PIPE,
+                                          stdout=__import__("subprocess").PIPE,
+                                          stderr=__import__("subprocess").DEVNULL)
+        self._write({"cells": self.cells})
+        ready = self._read(STARTUP_LIMIT + STATEMENT_LIMIT * len(self.cells))
+        self.names = [str(n) for n in ready.get("ready", [])]
+        self.notes = [str(n)[:300] for n in ready.get("notes", [])][:20]
+        return self
+
+    def _write(self, message):
+        pipe = self.process.proc.stdin
+        pipe.write((json.dumps(message) + "\n").encode())
+        pipe.flush()
+
+    def _read(self, timeout):
+        fd, chunks, size = self.process.proc.stdout.fileno(), [], 0
+        while True:
+            ready, _, _ = select.select([fd], [], [], timeout)
+            if not ready:
+                raise ProcessEnded(f"no answer within {timeout:g} s")
+            chunk = os.read(fd, 1 << 20)
+            if not chunk:
+                code = self.process.wait(5)
+                raise ProcessEnded(f"the process running your code ended (exit status {code}:"
+                                   " os._exit, a crash, or a CPU/memory limit)")
+            chunks.append(chunk)
+            size += len(chunk)
+            if size > MAX_REPLY:
+                raise ProcessEnded("your function's result is too large to check")
+            if chunk.endswith(b"\n"):
+                return json.loads(b"".join(chunks))
+
+    def call(self, target, args):
+        """target: a name (str) or a handle (int); returns the value or raises as the student's
+        function did (NotImplementedError, ik.StopSolve, or an error with its student_line)."""
+        from ...core.solve import StopSolve
+
+        if self.process is None:
+            raise ProcessEnded("the process running your code was ended earlier")
+        request = {"handle" if isinstance(target, int) else "name": target,
+                   "args": encode(list(args))}  # before the try: a value that cannot cross
+        try:                                    # (a JAX tracer) leaves the worker running
+            self._write(request)
+            reply = self._read(CALL_LIMIT)
+        except BaseException:  # a time limit, or a broken worker: end it, it may be busy
+            self.end()
+            raise
+        if "value" in reply:
+            return decode(reply["value"], call=self.call)
+        raised = reply.get("raise", {})
+        if raised.get("kind") == "stop":
+            raise StopSolve(raised.get("message", ""))
+        if raised.get("kind") == "not yet":
+            raise NotImplementedError
+        error = type(str(raised.get("type", "Error")) or "Error", (Exception,), {})(
+            str(raised.get("message", "")))
+        error.student_line = str(raised.get("line", ""))[:300]
+        raise error
+
+    def function(self, name):
+        return functools.wraps(_handle_doc)(lambda *args: self.call(name, args))
+
+    def end(self):
+        if self.process is not None:
+            self.process.end()
+            self.process = None
+
+
+if __name__ == "__main__":
+    worker()

@@ -1,0 +1,232 @@
+"""The lab's interactive demo: drag the target, watch the arm follow.
+
+    demo = ik.demo.Demo()          # widgets: target x, y, lambda, method, preset buttons
+    demo.widget                    # display it in a notebook
+    demo.update(x=3.5, y=1.0)      # what a slider change does; returns the Result
+
+Every change re-solves from the same start theta0 with ik.solve, redraws the arm, its
+start pose and the end effector's path into an image widget, and prints one line:
+method, status and iterations. The solve is compiled once per method (the target and
+lambda are traced numbers), so a change costs a few milliseconds of solving plus one
+PNG render. Without a browser, call update() and read .result, .summary, .png.
+
+The image is SIZE x SIZE CSS pixels beside its controls (fits a 1280x720 laptop screen
+with JupyterLab around it), rendered at HIDPI times that so it stays sharp on HiDPI
+screens. Only the moving artists are redrawn over a cached background (blitting), and
+the PNG is written with light compression. Displayed, the widget also carries a still
+(PNG + status line) that static pages (GitHub, nbconvert HTML) show in its place.
+"""
+import base64
+import html
+import struct
+import zlib
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from . import plot
+from ..core.chain import planar_chain, reach
+from ..core.solve import solve
+
+PRESETS = {
+    "reachable": (2.5, 0.5),
+    "near the edge": (2.99, 0.2),  # the "near edge" target of lectures 04 and 05
+    "unreachable": (3.5, 1.0),
+}
+METHOD_NAMES = ("dls", "pinv", "jt")
+SIZE = 400          # CSS pixels, the image's width and height on the page
+HIDPI = 2           # rendered at HIDPI x SIZE pixels
+CONTROLS_WIDTH = 370  # CSS pixels, the column of sliders, presets and status beside the image
+
+
+def summary(method, result):
+    """The line the demo prints: method, status, iterations and the final error."""
+    return (f"{method}: {result.status} after {result.iterations} iterations, "
+            f"|e| = {result.error:.4f}")
+
+
+def alt_text(arm, target, line):
+    """A description of the demo's picture for screen readers and static pages."""
+    return (f"Planar {arm.n_joints}-link arm inside its dashed reach circle, its start pose "
+            f"in grey, reaching for the target (cross) at ({target[0]:.2f}, {target[1]:.2f}); "
+            f"orange dots trace the end effector's path. {line}.")
+
+
+def png(rgba):
+    """An (h, w, 3 or 4) uint8 image as RGB PNG bytes, written for speed: no row filter and
+    zlib's run-length strategy (a plot is mostly runs of one colour), several times faster
+    than a general-purpose PNG encoder at a similar size."""
+    rgb = np.asarray(rgba)[..., :3]
+    h, w, _ = rgb.shape
+    rows = np.zeros((h, 3 * w + 1), dtype=np.uint8)  # each row: filter byte 0, then pixels
+    rows[:, 1:] = rgb.reshape(h, -1)
+    packer = zlib.compressobj(6, zlib.DEFLATED, 15, 9, zlib.Z_RLE)
+    pixels = packer.compress(rows.tobytes()) + packer.flush()
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    header = struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0)  # 8-bit RGB, no interlace
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", pixels) + chunk(b"IEND", b"")
+
+
+def still_html(png_bytes, alt, line, size=SIZE):
+    """The demo as static HTML: its image with alt text and the status line under it."""
+    data = base64.b64encode(png_bytes).decode("ascii")
+    return (f'<figure style="margin:0"><img src="data:image/png;base64,{data}" '
+            f'width="{size}" height="{size}" alt="{html.escape(alt)}">'
+            f"<figcaption><code>{html.escape(line)}</code> (a still: run the notebook to "
+            f"drag the target)</figcaption></figure>")
+
+
+def padded(thetas, n):
+    """thetas (k, d) with its last row repeated up to n rows, so jitted maps see one shape."""
+    thetas = np.asarray(thetas, dtype=float)
+    return np.concatenate([thetas, np.repeat(thetas[-1:], max(n - len(thetas), 0), axis=0)])
+
+
+def _widgets():
+    import ipywidgets as w
+
+    class PresetButtons(w.HBox):
+        """One button per preset; a click always applies it (also the same one twice).
+        Setting .value to a preset's name does what its click does."""
+
+        def __init__(self, presets, choose):
+            self._presets, self._choose, self._value = presets, choose, None
+            buttons = [w.Button(description=name, tooltip=f"target ({x:g}, {y:g})",
+                                layout=w.Layout(width="auto"))
+                       for name, (x, y) in presets.items()]
+            for button in buttons:
+                button.on_click(lambda b: setattr(self, "value", b.description))
+            super().__init__(buttons, layout=w.Layout(flex_flow="row wrap"))
+
+        @property
+        def value(self):
+            return self._value
+
+        @value.setter
+        def value(self, name):
+            if name not in self._presets:
+                raise ValueError(f"preset must be one of {list(self._presets)}, got {name!r}")
+            self._value = name
+            self._choose(name)
+
+    class DemoBox(w.HBox):
+        """The demo's layout; in a static view its still (image + status) stands in."""
+
+        def _repr_mimebundle_(self, **kwargs):
+            data = super()._repr_mimebundle_(**kwargs)
+            png_bytes, alt, line = self.still()
+            data.update({"text/plain": line, "text/html": still_html(png_bytes, alt, line),
+                         "image/png": base64.b64encode(png_bytes).decode("ascii")})
+            return data, {"image/png": {"width": SIZE, "height": SIZE, "alt": alt}}
+
+    return w, PresetButtons, DemoBox
+
+
+class Demo:
+    """Sliders for the target and lambda, a method dropdown and preset buttons, re-solving on change."""
+
+    def __init__(self, arm=None, theta0=(0.1, 0.2, 0.3), target=PRESETS["reachable"],
+                 method="dls", damping=0.5, tol=1e-3, max_iter=300, clamp=None):
+        w, PresetButtons, DemoBox = _widgets()
+        self.arm = planar_chain([1.0, 1.0, 1.0]) if arm is None else arm
+        self.theta0 = np.asarray(theta0, dtype=float)
+        self.tol, self.max_iter, self.clamp = tol, max_iter, clamp
+        r = 1.3 * float(reach(self.arm))
+        full = w.Layout(width="100%")
+        style = {"description_width": "62px"}
+        slider = dict(min=-r, max=r, step=0.05, continuous_update=True, readout_format=".2f",
+                      layout=full, style=style)
+        self.x = w.FloatSlider(value=float(target[0]), description="target x", **slider)
+        self.y = w.FloatSlider(value=float(target[1]), description="target y", **slider)
+        self.damping = w.FloatSlider(value=damping, min=0.0, max=2.0, step=0.05, layout=full,
+                                     style=style, description="λ (dls)", readout_format=".2f")
+        self.method = w.Dropdown(options=list(METHOD_NAMES), value=method, description="method",
+                                 style=style)
+        self.preset = PresetButtons(PRESETS, self._preset_chosen)
+        px = f"{SIZE}px"
+        self.image = w.Image(format="png", width=str(SIZE), height=str(SIZE),
+                             layout=w.Layout(width=px, height=px, min_width=px, flex="0 0 auto"))
+        self.text = w.Label(layout=full)
+        controls = w.VBox([self.x, self.y, self.damping, self.method, w.Label("presets"),
+                           self.preset, self.text],
+                          layout=w.Layout(width=f"{CONTROLS_WIDTH}px", flex="0 0 auto"))
+        self.widget = DemoBox([self.image, controls],
+                              layout=w.Layout(flex_flow="row wrap", align_items="flex-start"))
+        self.widget.still = lambda: (self.png, self.alt, self.summary)
+        self._build_figure(target)
+        self._holding = False
+        for control in (self.x, self.y, self.damping, self.method):
+            control.observe(self._changed, names="value")
+        self.result = None
+        self.update()
+
+    def _build_figure(self, target):
+        """The static picture once (axes, reach circle, start pose) as a cached background;
+        the path, arm and target are animated artists drawn over it on each update."""
+        inches = SIZE / 100
+        self._fig = Figure(figsize=(inches, inches), dpi=100 * HIDPI)
+        self._canvas = FigureCanvasAgg(self._fig)
+        self._ax = ax = self._fig.add_axes((0.01, 0.01, 0.98, 0.98))
+        plot.arm_axes(ax, self.arm, margin=1.3)
+        ax.set_xticks([])
+        ax.set_yticks([])
+        plot.draw_reach(ax, self.arm)
+        plot.draw_arm(ax, self.arm, self.theta0, color="0.7", lw=2, joints=False)
+        (self._path,) = ax.plot([], [], ".-", color="C1", lw=1, ms=3, alpha=0.7)
+        self._arm = plot.draw_arm(ax, self.arm, self.theta0)
+        self._target = plot.draw_target(ax, target)
+        self._moving = [self._path, *self._arm, self._target]
+        for artist in self._moving:
+            artist.set_animated(True)
+        self._canvas.draw()
+        self._background = self._canvas.copy_from_bbox(self._fig.bbox)
+
+    def _changed(self, _change):
+        if not self._holding:
+            self.update()
+
+    def _preset_chosen(self, name):
+        x, y = PRESETS[name]
+        self.update(x=x, y=y)
+
+    def update(self, x=None, y=None, damping=None, method=None):
+        """Set any controls given, then solve once and redraw. Returns the Result."""
+        self._holding = True
+        try:
+            for control, value in ((self.x, x), (self.y, y), (self.damping, damping),
+                                   (self.method, method)):
+                if value is not None:
+                    control.value = value
+        finally:
+            self._holding = False
+        target = np.array([self.x.value, self.y.value])
+        self.result = solve(self.arm, target, self.theta0, method=self.method.value,
+                            damping=self.damping.value, tol=self.tol, max_iter=self.max_iter,
+                            clamp=self.clamp)
+        self.summary = summary(self.method.value, self.result)
+        self.alt = alt_text(self.arm, target, self.summary)  # the still's <img alt>
+        self.text.value = self.summary
+        self.png = self._draw(target)
+        self.image.value = self.png
+        return self.result
+
+    def _draw(self, target):
+        """Move the animated artists, draw them over the cached background, return a PNG."""
+        thetas = self.result.trace.theta
+        path = plot.end_path(self.arm, padded(thetas, self.max_iter + 1))[: len(thetas)]
+        self._path.set_data(path[:, 0], path[:, 1])
+        plot.set_arm(self._arm, self.arm, self.result.theta)
+        color = plot.color_for(self.method.value)
+        for artist in self._arm:
+            artist.set_color(color)
+            artist.set_markeredgecolor(color)
+        self._arm[1].set_markerfacecolor("white")
+        self._target.set_data([target[0]], [target[1]])
+        self._canvas.restore_region(self._background)
+        for artist in self._moving:
+            self._ax.draw_artist(artist)
+        return png(self._canvas.buffer_rgba())
