@@ -88,3 +88,42 @@ def test_paths_of_any_length_track_with_one_program():
         np.testing.assert_array_equal(part.theta, whole.theta[: steps + 1])
         np.testing.assert_array_equal(part.error, whole.error[:steps])
     assert len(COMPILES) == before, COMPILES[before:]
+
+
+def test_a_new_max_iter_or_a_long_solve_compiles_nothing_new():
+    """max_iter is traced: any value reuses the compiled loop, and a solve longer than one
+    chunk of trace runs the same program again."""
+    ik.solve(ARM, [1.5, 1.0], START, method="jt", max_iter=300)
+    ik.solve_batch(ARM, np.array([[1.0, 1.0], [9.0, 0.0]]), START, method="jt", max_iter=300)
+    before = len(COMPILES)
+    for max_iter in (1, 2, 63, 64, 65, 129, 4096, 10**6):
+        res = ik.solve(ARM, [9.0, 0.0], START, method="jt", max_iter=max_iter, stall_tol=0)
+        assert res.iterations == max_iter or res.status != "max_iter"
+        assert res.trace.theta.shape == (res.iterations + 1, 3)
+        assert res.trace.error.shape == (res.iterations + 1,)
+        if max_iter > 4096:
+            break
+    ik.solve_batch(ARM, np.array([[1.0, 1.0], [9.0, 0.0]]), START, method="jt", max_iter=77)
+    assert len(COMPILES) == before, COMPILES[before:]
+
+
+def test_the_trace_follows_the_iterations_not_max_iter():
+    """A target met at the start keeps one row of trace, whatever max_iter allows; above the
+    cap max_iter is a ValueError naming it."""
+    arm = ik.planar_chain([1.0] * 12)
+    res = ik.solve(arm, np.asarray(ik.fk(arm, np.zeros(12))), np.zeros(12), max_iter=10**6)
+    assert (res.status, res.iterations, res.trace.theta.shape) == ("converged", 0, (1, 12))
+    with pytest.raises(ValueError, match="max_iter: expected at most"):
+        ik.solve(arm, [1.0, 1.0], np.zeros(12), max_iter=2**40)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_a_trace_across_chunks_is_the_trace_of_one_long_run(method):
+    """Iterates recorded across chunk boundaries: each row is the step from the row before,
+    and the errors are the errors of those rows."""
+    res = ik.solve(ARM, [2.9, 0.4], START, method=method, max_iter=200, stall_tol=0, tol=1e-12)
+    assert res.iterations > 64 or res.status != "max_iter"
+    for k in range(res.iterations + 1):
+        err = np.linalg.norm(np.array([2.9, 0.4]) - np.asarray(ik.fk(ARM, res.trace.theta[k])))
+        assert abs(err - res.trace.error[k]) < 1e-12, k
+    np.testing.assert_array_equal(res.trace.theta[-1], res.theta)

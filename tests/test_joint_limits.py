@@ -136,7 +136,7 @@ def test_limits_on_a_built_in_method_are_compiled_without_a_trial_trace(monkeypa
     solve goes straight to the compiled loop (only a user's step is tried by tracing it)."""
     import importlib
 
-    solve_module = importlib.import_module("ikteach.core.solve")
+    solve_module = importlib.import_module("ikteach.core.methods")
     from ikteach.core.joint_limits import LimitedMethod
 
     assert solve_module.built_in(LimitedMethod(solve_module.METHODS["pinv"], "clamp"))

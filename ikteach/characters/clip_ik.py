@@ -31,7 +31,7 @@ class MaskedTreeTask(TreeTask):
         return e, J * jnp.asarray(self.mask)
 
 
-@partial(runtime_jit.jit, static_argnames=("task", "max_iter"))
+@partial(runtime_jit.jit, static_argnames=("task",))
 def _solve_clip(task, arm, targets, theta, settings, max_iter):
     method = METHODS["dls"]
 
@@ -79,6 +79,6 @@ def solve_clip(rig, root, theta, targets, active, tol=1e-3, max_iter=50, damping
     task = MaskedTreeTask(mask=tuple(mask.tolist()))
     local = targets - root[:, None, :]          # the tree is built around the root
     thetas, errors, iterations, status = _solve_clip(task, rig.tree, jnp.asarray(local), jnp.asarray(theta),
-                                                     settings, as_count(max_iter, "max_iter"))
+                                                     settings, np.int64(as_count(max_iter, "max_iter")))
     return ClipResult(np.asarray(thetas), np.asarray(errors), np.asarray(iterations),
                       np.asarray(STATUSES, dtype=object)[np.asarray(status)])

@@ -27,7 +27,7 @@ from .pinv import DEFAULT_RCOND
 from .sdls import GAMMA_MAX
 from .levels import DEFAULT_REST_GAIN
 from .solve import (DEFAULT_DAMPING, RUNNING, STATUSES, _run_jit, advance, check_problem,
-                    initial_state, resolve_method, status_counts, with_extras)
+                    initial_state, resolve_method, run_chunks, status_counts, with_extras)
 from .._runtime import jit as runtime_jit
 
 SLOTS = 1024  # targets in flight at once (per device)
@@ -62,7 +62,7 @@ def _queue(method, task, arm, targets, thetas0, settings, max_iter, slots):
     """Solve every target; `slots` of them in flight, refilled from the queue as they finish."""
     count = targets.shape[0]
     step = jax.vmap(lambda t, s: advance(method, task, arm, t, settings, max_iter, s))
-    start = jax.vmap(lambda q: initial_state(q, max_iter, False))
+    start = jax.vmap(lambda q: initial_state(q, False))
 
     def load(index):  # fresh states for these targets; an index past the end marks an idle slot
         state = start(thetas0[jnp.minimum(index, count - 1)])
@@ -88,7 +88,7 @@ def _queue(method, task, arm, targets, thetas0, settings, max_iter, slots):
     return jax.lax.while_loop(lambda c: jnp.any(c[1].status == RUNNING), body, carry)[2]
 
 
-_run_queue = partial(runtime_jit.jit, static_argnames=("method", "task", "max_iter", "slots"))(_queue)
+_run_queue = partial(runtime_jit.jit, static_argnames=("method", "task", "slots"))(_queue)
 
 
 def _shard_map():
@@ -108,7 +108,7 @@ def _mesh(devices):
     return jax.sharding.Mesh(np.array(devices), ("targets",))
 
 
-@partial(runtime_jit.jit, static_argnames=("method", "task", "max_iter", "slots", "mesh"))
+@partial(runtime_jit.jit, static_argnames=("method", "task", "slots", "mesh"))
 def _run_split(method, task, arm, targets, thetas0, settings, max_iter, slots, mesh):
     """_queue on every device of the mesh, each on its share of the rows of targets."""
     shard_map, check_off = _shard_map()
@@ -134,7 +134,7 @@ def _run(method, task, arm, targets, thetas0, settings, max_iter):
     """_run_queue on one device, or _run_split over all of them: device k takes rows k, k + D,
     k + 2D, ... (neighbouring targets cost alike, so the shares take about as long), the rows
     padded to a multiple of D with copies of the last one, dropped again."""
-    count = targets.shape[0]
+    count, max_iter = targets.shape[0], np.int64(max_iter)  # traced: any max_iter, one program
     if count <= SMALL_BATCH:
         return _one_by_one(method, task, arm, targets, thetas0, settings, max_iter)
     devices = split_devices(count)
@@ -152,10 +152,11 @@ def _run(method, task, arm, targets, thetas0, settings, max_iter):
 
 
 def _one_by_one(method, task, arm, targets, thetas0, settings, max_iter):
-    """ik.solve's compiled loop (no trace) on each row, the states stacked row by row. The rows
-    are cut on the host: indexing a device array would dispatch two small programs per row."""
+    """ik.solve's own compiled loop on each row (its trace dropped), the states stacked row by
+    row. The rows are cut on the host: indexing a device array would dispatch two small
+    programs per row."""
     rows, starts = np.asarray(targets), np.asarray(thetas0)
-    states = [_run_jit(method, task, arm, rows[k], starts[k], settings, max_iter, False)
+    states = [run_chunks(_run_jit, method, task, arm, rows[k], starts[k], settings, max_iter)[0]
               for k in range(rows.shape[0])]
     return jax.tree_util.tree_map(lambda *rows: np.stack([np.asarray(r) for r in rows]), *states)
 

@@ -11,24 +11,20 @@ Each iteration, at the current theta:
      and keeps the last finite theta.
 """
 import dataclasses
-import inspect
 from functools import partial
-from typing import Callable, NamedTuple
+from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
 from ._validate import as_array, as_count, as_number
-from .ccd import CCDMethod
-from .dls import dls_step
-from .fabrik import FABRIKMethod
-from .sdls import GAMMA_MAX, SDLSMethod
-from .jt import jt_step
-from .levels import DEFAULT_REST_GAIN, PriorityMethod, with_priorities
-from .joint_limits import LimitedMethod, with_limits
-from .limits import cap_step, clamp_error
-from .pinv import DEFAULT_RCOND, pinv_step, pinv_two_rows
+from .sdls import GAMMA_MAX
+from .levels import DEFAULT_REST_GAIN, with_priorities
+from .joint_limits import with_limits
+from .limits import cap_step
+from .methods import METHODS, resolve_method, traceable
+from .pinv import DEFAULT_RCOND
 from .tasks import task_for
 from . import stop_rules
 from .._runtime import jit as runtime_jit
@@ -66,43 +62,6 @@ class Settings(NamedTuple):
     rest_pose: object = 0.0  # the rest-pose level of a prioritised solve (ikteach/levels.py)
     rest_gain: float = 0.0
     stop_rule: int = 0  # index into stop_rules.STOP_RULES
-
-
-def _jt(J, e, s):
-    return jt_step(J, e)
-
-
-def _pinv(J, e, s):
-    if J.shape[0] == 2:  # planar position targets: the closed form, no SVD call
-        return pinv_two_rows(J, e, s.rcond)
-    return pinv_step(J, e, s.rcond)
-
-
-def _dls(J, e, s):
-    return dls_step(J, e, s.damping)
-
-
-@dataclasses.dataclass(frozen=True)
-class JacobianMethod:
-    """A method that turns (J, clamped e) into a step: step(J, e, settings) -> delta_theta."""
-    step: Callable
-
-    def delta(self, task, arm, target, theta, e, settings):
-        J = task.jacobian(arm, theta)
-        return self.step(J, clamp_error(e, settings.clamp), settings)
-
-
-@dataclasses.dataclass(frozen=True)
-class UserStep:
-    """A step function step(J, e) -> delta_theta given by the user."""
-    fn: Callable
-
-    def __call__(self, J, e, s):
-        return self.fn(J, e)
-
-
-METHODS = {"jt": JacobianMethod(_jt), "pinv": JacobianMethod(_pinv), "dls": JacobianMethod(_dls)}
-METHODS.update(sdls=SDLSMethod(), ccd=CCDMethod(), fabrik=FABRIKMethod())
 
 
 @dataclasses.dataclass(frozen=True)
@@ -164,11 +123,13 @@ def linearize(task, arm, target, theta):
     return e, _Linearized(task, theta, J)
 
 
-def advance(method, task, arm, target, settings, max_iter, state):
-    """One pass of the loop described in the module docstring."""
+def advance(method, task, arm, target, settings, max_iter, state, first=0):
+    """One pass of the loop described in the module docstring. The trace holds the iterations
+    from `first` on (solve runs the loop TRACE_CHUNK iterations at a time)."""
     e, task = linearize(task, arm, target, state.theta)
     err = jnp.linalg.norm(e)
-    trace_error = state.trace_error.at[state.i].set(err) if state.trace_error.size else state.trace_error
+    row = state.i - first
+    trace_error = state.trace_error.at[row].set(err) if state.trace_error.size else state.trace_error
     status = jnp.select(
         [~jnp.isfinite(err), err < settings.tol,
          (state.i > 0) & (state.last_step < settings.stall_tol), state.i >= max_iter],
@@ -188,96 +149,79 @@ def advance(method, task, arm, target, settings, max_iter, state):
     theta = jnp.where(take, new_theta, state.theta)
     trace_theta = state.trace_theta
     if trace_theta.size:
-        trace_theta = jnp.where(take, trace_theta.at[i].set(new_theta), trace_theta)
+        trace_theta = jnp.where(take, trace_theta.at[row + 1].set(new_theta), trace_theta)
     size = stop_rules.step_size(settings.stop_rule, lambda: task.jacobian(arm, state.theta), delta)
     return State(i, theta, err, jnp.where(take, size, state.last_step),
                  status, trace_theta, trace_error)
 
 
-def initial_state(theta0, max_iter, record):
+TRACE_CHUNK = 64   # iterations per compiled run when the trace is kept (memory follows the work)
+MAX_ITER_CAP = 10**6  # the largest max_iter accepted: a full trace of 12 joints is then 100 MB
+
+
+def initial_state(theta0, record):
+    """The state before iteration 0; with record, room for one chunk of trace."""
     n = theta0.shape[0]
-    rows = max_iter + 1 if record else 0
-    trace_theta = jnp.zeros((rows, n)).at[0].set(theta0) if record else jnp.zeros((0, n))
-    return State(jnp.asarray(0), theta0, jnp.asarray(jnp.inf), jnp.asarray(jnp.inf),
-                 jnp.asarray(RUNNING), trace_theta, jnp.zeros((rows,)))
+    rows = TRACE_CHUNK + 1 if record else 0
+    inf = jnp.asarray(np.inf, dtype=jnp.float64)  # strongly typed: a state fed back in
+    return State(jnp.asarray(0, dtype=jnp.int64), theta0, inf, inf,  # reuses the program
+                 jnp.asarray(RUNNING, dtype=jnp.int64), jnp.zeros((rows, n)), jnp.zeros((rows,)))
 
 
-def run_loop(method, task, arm, target, theta0, settings, max_iter, record):
-    """The loop as a lax.while_loop (traceable: used under jit and vmap)."""
-    body = partial(advance, method, task, arm, target, settings, max_iter)
-    return jax.lax.while_loop(lambda s: s.status == RUNNING, body,
-                              initial_state(theta0, max_iter, record))
+def run_loop(method, task, arm, target, theta0, settings, max_iter, record=False, state=None):
+    """The loop as a lax.while_loop (traceable: used under jit and vmap), from theta0 or from a
+    state. Without record it runs to the end; with record it stops after TRACE_CHUNK
+    iterations (or at the end), its trace holding iterations state.i, state.i + 1, ..."""
+    state = initial_state(theta0, record) if state is None else state
+    first = state.i
+    if record:
+        state = state._replace(trace_theta=jnp.zeros_like(state.trace_theta).at[0].set(state.theta),
+                               trace_error=jnp.zeros_like(state.trace_error))
+    body = partial(advance, method, task, arm, target, settings, max_iter, first=first)
+    more = (lambda s: (s.status == RUNNING) & (s.i < first + TRACE_CHUNK)) if record else \
+        (lambda s: s.status == RUNNING)
+    return jax.lax.while_loop(more, body, state)
 
 
-@partial(runtime_jit.jit, static_argnames=("method", "task", "max_iter", "record"))
-def _run_jit(method, task, arm, target, theta0, settings, max_iter, record):
-    """The compiled loop, run as a batch of one so that its arithmetic is the batched
-    arithmetic of solve_batch: the same target gives the same iterates to the last bit."""
-    one = lambda t, q: run_loop(method, task, arm, t, q, settings, max_iter, record)
-    state = jax.vmap(one)(target[None], theta0[None])
-    return jax.tree_util.tree_map(lambda x: x[0], state)
+@partial(runtime_jit.jit, static_argnames=("method", "task"))
+def _run_jit(method, task, arm, target, state, settings, max_iter):
+    """One chunk of the compiled loop, run as a batch of one so that its arithmetic is the
+    batched arithmetic of solve_batch. max_iter is traced: any iteration count reuses it."""
+    one = lambda t, s: run_loop(method, task, arm, t, None, settings, max_iter, True, s)
+    out = jax.vmap(one)(target[None], jax.tree_util.tree_map(lambda x: x[None], state))
+    return jax.tree_util.tree_map(lambda x: x[0], out)
 
 
-def _run_eager(method, task, arm, target, theta0, settings, max_iter, record):
-    """The same loop, one Python iteration at a time, for step functions JAX cannot trace."""
-    state = initial_state(theta0, max_iter, record)
-    while int(state.status) == RUNNING:
+def _run_eager(method, task, arm, target, state, settings, max_iter):
+    """The same chunk, one Python iteration at a time, for step functions JAX cannot trace."""
+    first = int(state.i)
+    state = state._replace(trace_theta=jnp.zeros_like(state.trace_theta).at[0].set(state.theta),
+                           trace_error=jnp.zeros_like(state.trace_error))
+    while int(state.status) == RUNNING and int(state.i) < first + TRACE_CHUNK:
         try:
-            state = advance(method, task, arm, target, settings, max_iter, state)
+            state = advance(method, task, arm, target, settings, max_iter, state, first)
         except StopSolve:  # the step function's own stop rule fired
             err = jnp.linalg.norm(task.error(arm, target, state.theta))
-            trace_error = state.trace_error.at[state.i].set(err) if record else state.trace_error
             status = CONVERGED if err < settings.tol else STALLED  # same order as advance
-            state = state._replace(error=err, status=jnp.asarray(status), trace_error=trace_error)
+            state = state._replace(error=err, status=jnp.asarray(status),
+                                   trace_error=state.trace_error.at[int(state.i) - first].set(err))
     return state
 
 
-_TRACEABLE = {}
-
-
-def traceable(method, task, arm, target, theta0, settings):
-    """Can JAX trace the method (pure jax.numpy), or does it need eager execution?
-
-    Built-in methods are JAX code; a user's step is tried once per problem shape.
-    """
-    if built_in(method):
-        return True
-    key = (method, task, type(arm), arm.dim, target.shape, theta0.shape)
-    if key not in _TRACEABLE:
-        try:
-            jax.eval_shape(lambda q: method.delta(task, arm, target, q, task.error(arm, target, q),
-                                                  settings), theta0)
-            _TRACEABLE[key] = True
-        except Exception:
-            _TRACEABLE[key] = False
-    return _TRACEABLE[key]
-
-
-def built_in(method):
-    """Is the method ikteach's own JAX code: a built-in method, the priority step, or one of
-    those within joint limits? (Only a user's step function needs trying.)"""
-    if isinstance(method, LimitedMethod):
-        return built_in(method.inner)
-    return method in METHODS.values() or isinstance(method, PriorityMethod)
-
-
-def resolve_method(method):
-    """A method name or a step function step(J, e) -> the loop's step(J, e, settings)."""
-    if isinstance(method, str):
-        if method not in METHODS:
-            raise ValueError(f"method: expected one of {sorted(METHODS)} or a function "
-                             f"step(J, e) -> delta_theta, got {method!r}")
-        return METHODS[method]
-    if callable(method):
-        try:
-            inspect.signature(method).bind(None, None)
-        except TypeError:
-            raise ValueError("method: a step function must accept two arguments (J, e)") from None
-        except ValueError:
-            pass  # builtins without a signature
-        return JacobianMethod(UserStep(method))
-    raise ValueError(f"method: expected one of {sorted(METHODS)} or a function "
-                     f"step(J, e) -> delta_theta, got {method!r:.80}")
+def run_chunks(run, method, task, arm, target, theta0, settings, max_iter):
+    """Run the loop chunk by chunk (run: _run_jit or _run_eager) until it stops; returns the
+    last state (on the host) and the whole trace, theta (k + 1, n) and error (k + 1,)."""
+    state, thetas, errors = initial_state(theta0, True), [], []
+    max_iter = np.int64(max_iter)
+    while True:
+        first = int(state.i)
+        state = jax.device_get(run(method, task, arm, target, state, settings, max_iter))
+        k = int(state.i) - first
+        done = int(state.status) != RUNNING
+        thetas.append(state.trace_theta[: k + done])
+        errors.append(state.trace_error[: k + done])
+        if done:
+            return state, np.concatenate(thetas), np.concatenate(errors)
 
 
 def with_extras(method, task, arm, target, theta0, settings, levels, rest_pose, rest_gain,
@@ -314,6 +258,9 @@ def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, 
     else:
         theta0 = as_array(theta0, "theta0", shape=(n,))
     max_iter = as_count(max_iter, "max_iter", minimum=1)
+    if max_iter > MAX_ITER_CAP:
+        raise ValueError(f"max_iter: expected at most {MAX_ITER_CAP:,} iterations (ik.solve keeps "
+                         f"every iterate), got {max_iter:,}")
     if stall_tol is None:
         stall_tol = STALL_FRACTION * task.length_scale(arm)
     settings = Settings(
@@ -338,7 +285,8 @@ def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DE
     method    "jt", "pinv", "dls", "sdls", "ccd", "fabrik", or a function step(J, e) -> delta_theta
               (it may raise ik.StopSolve to end the solve "stalled": its own stop rule).
     tol       stop "converged" when ||e|| < tol.
-    max_iter  stop "max_iter" after this many steps.
+    max_iter  stop "max_iter" after this many steps (at most MAX_ITER_CAP; any value reuses the
+              compiled loop, and the trace grows with the iterations taken, not with max_iter).
     damping   lambda of DLS.   rcond: the pseudoinverse's relative cut-off.
     clamp     Buss's D_max: |e| is clamped to at most D_max before each step.
     max_step  cap on any joint's change per step, in radians.
@@ -366,12 +314,10 @@ def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DE
         weights=weights, stop_rule=stop_rule)
     method, settings, theta0 = with_extras(method, task, arm, target, theta0, settings, levels,
                                            rest_pose, rest_gain, joint_limits, limit_mode)
-    args = (method, task, arm, target, theta0, settings, max_iter, True)
-    state = (_run_jit if traceable(*args[:6]) else _run_eager)(*args)
-    state = jax.device_get(state)  # slice on the host: a device slice would compile per length
-    k = int(state.i)
-    trace = Trace(_frozen(state.trace_theta[: k + 1]), _frozen(state.trace_error[: k + 1]))
-    return Result(_frozen(state.theta), STATUSES[int(state.status)], k, float(state.error), trace)
+    run = _run_jit if traceable(method, task, arm, target, theta0, settings) else _run_eager
+    state, thetas, errors = run_chunks(run, method, task, arm, target, theta0, settings, max_iter)
+    return Result(_frozen(state.theta), STATUSES[int(state.status)], int(state.i),
+                  float(state.error), Trace(_frozen(thetas), _frozen(errors)))
 
 
 def _frozen(x):
