@@ -127,3 +127,15 @@ def test_a_trace_across_chunks_is_the_trace_of_one_long_run(method):
         err = np.linalg.norm(np.array([2.9, 0.4]) - np.asarray(ik.fk(ARM, res.trace.theta[k])))
         assert abs(err - res.trace.error[k]) < 1e-12, k
     np.testing.assert_array_equal(res.trace.theta[-1], res.theta)
+
+
+def test_new_pose_weights_compile_nothing_new():
+    """PoseTask's weights are traced data: a new (position, orientation) pair reuses the loop."""
+    ur5 = ik.ur5()
+    target = np.asarray(ik.fk_pose(ur5, np.full(6, 0.4)))
+    first = ik.solve(ur5, target, np.zeros(6), weights=(1.0, 0.5))
+    before = len(COMPILES)
+    results = [ik.solve(ur5, target, np.zeros(6), weights=w) for w in [(1.0, 0.3), (2.0, 1.0), (0.7, 0.1)]]
+    assert len(COMPILES) == before, COMPILES[before:]
+    assert len({r.iterations for r in [first, *results]}) > 1  # the weights did matter
+    assert all(r.status == "converged" for r in results)

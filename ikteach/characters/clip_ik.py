@@ -6,7 +6,6 @@ instead of being found afresh each frame. Joints outside `active` keep the clip'
 their Jacobian columns are zeroed, so DLS never turns them.
 """
 import dataclasses
-from functools import partial
 
 import jax
 import jax.numpy as jnp
@@ -31,7 +30,10 @@ class MaskedTreeTask(TreeTask):
         return e, J * jnp.asarray(self.mask)
 
 
-@partial(runtime_jit.jit, static_argnames=("task",))
+jax.tree_util.register_dataclass(MaskedTreeTask, data_fields=[], meta_fields=["mask"])
+
+
+@runtime_jit.jit
 def _solve_clip(task, arm, targets, theta, settings, max_iter):
     method = METHODS["dls"]
 

@@ -88,7 +88,7 @@ def _queue(method, task, arm, targets, thetas0, settings, max_iter, slots):
     return jax.lax.while_loop(lambda c: jnp.any(c[1].status == RUNNING), body, carry)[2]
 
 
-_run_queue = partial(runtime_jit.jit, static_argnames=("method", "task", "slots"))(_queue)
+_run_queue = partial(runtime_jit.jit, static_argnames=("method", "slots"))(_queue)
 
 
 def _shard_map():
@@ -108,17 +108,17 @@ def _mesh(devices):
     return jax.sharding.Mesh(np.array(devices), ("targets",))
 
 
-@partial(runtime_jit.jit, static_argnames=("method", "task", "slots", "mesh"))
+@partial(runtime_jit.jit, static_argnames=("method", "slots", "mesh"))
 def _run_split(method, task, arm, targets, thetas0, settings, max_iter, slots, mesh):
     """_queue on every device of the mesh, each on its share of the rows of targets."""
     shard_map, check_off = _shard_map()
     P = jax.sharding.PartitionSpec
 
-    def share(arm, settings, targets, thetas0):
+    def share(task, arm, settings, max_iter, targets, thetas0):
         return _queue(method, task, arm, targets, thetas0, settings, max_iter, slots)
 
-    return shard_map(share, mesh=mesh, in_specs=(P(), P(), P("targets"), P("targets")),
-                     out_specs=P("targets"), **check_off)(arm, settings, targets, thetas0)
+    return shard_map(share, mesh=mesh, in_specs=(P(), P(), P(), P(), P("targets"), P("targets")),
+                     out_specs=P("targets"), **check_off)(task, arm, settings, max_iter, targets, thetas0)
 
 
 def split_devices(count):

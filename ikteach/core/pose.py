@@ -99,7 +99,8 @@ class PoseTask:
     """Reach a 4x4 pose with a spatial chain.
 
     e = [beta_p (p_t - p); beta_o log(R_t R^T)],  J = diag(beta_p I, beta_o I) [z_i x (p_e - p_i); z_i].
-    The weights are fixed per task (ik.solve(..., weights=(beta_p, beta_o)) makes a new one).
+    The weights are the task's data (a pytree leaf each): traced, so new weights reuse the
+    compiled loop (ik.solve(..., weights=(beta_p, beta_o)) makes a new task, not a program).
     """
     position_weight: float = 1.0
     orientation_weight: float = 1.0
@@ -138,6 +139,10 @@ class PoseTask:
         if w_p == 0 and w_o == 0:
             raise ValueError("weights: expected at least one positive weight, got (0, 0)")
         return PoseTask(w_p, w_o)
+
+
+jax.tree_util.register_dataclass(PoseTask, data_fields=["position_weight", "orientation_weight"],
+                                 meta_fields=[])
 
 
 def pose_errors(arm, theta, target):

@@ -183,7 +183,7 @@ def run_loop(method, task, arm, target, theta0, settings, max_iter, record=False
     return jax.lax.while_loop(more, body, state)
 
 
-@partial(runtime_jit.jit, static_argnames=("method", "task"))
+@partial(runtime_jit.jit, static_argnames=("method",))
 def _run_jit(method, task, arm, target, state, settings, max_iter):
     """One chunk of the compiled loop, run as a batch of one so that its arithmetic is the
     batched arithmetic of solve_batch. max_iter is traced: any iteration count reuses it."""

@@ -6,6 +6,8 @@ built in; other tasks (pose targets, trees) add themselves to TASKS.
 """
 import dataclasses
 
+import jax
+
 from .chain import Chain, reach
 from .jacobian import jacobian, jacobian_from_frames
 from .kinematics import fk, joint_frames
@@ -39,6 +41,11 @@ class PositionTask:
     def length_scale(self, arm):
         return float(reach(arm))
 
+
+# Tasks travel into the compiled loops as pytrees: data (PoseTask's weights) is traced,
+# everything else is part of the program's key.
+jax.tree_util.register_dataclass(PositionTask, data_fields=[], meta_fields=[])
+jax.tree_util.register_dataclass(TreeTask, data_fields=[], meta_fields=[])
 
 TASKS = [PositionTask()]
 TASKS.append(TreeTask())  # trees: one target per end effector (ikteach/tree.py)

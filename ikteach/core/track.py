@@ -49,7 +49,7 @@ def clamp_blocks(e, block, d_max):
 CHUNK = 128  # time steps per compiled scan: paths of any length reuse one program
 
 
-@partial(runtime_jit.jit, static_argnames=("method", "task"))
+@partial(runtime_jit.jit, static_argnames=("method",))
 def _track(method, task, arm, targets, theta0, settings, d_max):
     """CHUNK (or fewer) steps; returns the last theta and every step's theta and error."""
     block = getattr(task, "block_size", None)
