@@ -2,6 +2,7 @@ import numpy as np
 import pytest
 
 import ikteach as ik
+from ikteach.core import batch
 
 ARM = ik.planar_chain([1.0, 1.0, 1.0])
 START = np.array([0.1, 0.2, 0.3])
@@ -73,3 +74,35 @@ def test_a_small_batch_of_tree_and_pose_targets_has_the_queues_bits(monkeypatch)
     poses = np.stack([np.asarray(ik.fk_pose(ur5, g[:6])) for g in goals])
     _same(*_small_then_queued(monkeypatch, lambda k: ik.solve_batch(
         ur5, poses[:k], np.full(6, 0.2), method="dls", tol=1e-6, max_iter=300, damping=0.05)))
+
+
+def _task_kinds():
+    rng = np.random.default_rng(5)
+    planar, ur5, Y = ik.planar_chain([1.0, 0.8, 0.5]), ik.ur5(), ik.buss_trees.y_tree()
+    starts = rng.uniform(-1.5, 1.5, size=(12, 6))
+    return {
+        "planar": (planar, rng.uniform(-2.5, 2.5, size=(12, 2)), np.array([0.3, 0.2, 0.1]), {}),
+        "spatial position": (ur5, np.stack([np.asarray(ik.fk(ur5, q)) for q in starts]),
+                             np.full(6, 0.1), {}),
+        "pose": (ur5, np.stack([np.asarray(ik.fk_pose(ur5, q)) for q in starts]), np.full(6, 0.1), {}),
+        "tree": (Y, rng.uniform(-1.5, 1.5, size=(12, 2, 3)) + np.array([0, 2.0, 0]), np.zeros(7), {}),
+        "tree levels": (Y, rng.uniform(-1.5, 1.5, size=(12, 2, 3)) + np.array([0, 2.0, 0]),
+                        np.zeros(7), {"levels": (0, 1)}),
+        "joint limits": (planar, rng.uniform(-2.5, 2.5, size=(12, 2)), np.array([0.3, 0.2, 0.1]),
+                         {"joint_limits": (np.full(3, -1.5), np.full(3, 1.5))}),
+    }
+
+
+@pytest.mark.parametrize("kind", list(_task_kinds()))
+def test_a_queued_batch_gives_what_solve_gives_on_every_task_kind(kind):
+    """More than SMALL_BATCH rows run through the queue (vectorised over slots); every row ends
+    exactly where ik.solve ends from the same start: same status, iterations and bits."""
+    arm, targets, start, kw = _task_kinds()[kind]
+    assert len(targets) > batch.SMALL_BATCH
+    methods = ("dls",) if "levels" in kw else ("jt", "pinv", "dls", "sdls")
+    for method in methods:
+        rows = ik.solve_batch(arm, targets, start, method=method, max_iter=300, **kw)
+        for k in range(len(targets)):
+            one = ik.solve(arm, targets[k], start, method=method, max_iter=300, **kw)
+            assert (one.status, one.iterations) == (rows.status[k], rows.iterations[k]), (method, k)
+            np.testing.assert_array_equal(one.theta, rows.theta[k], err_msg=f"{method} row {k}")

@@ -170,7 +170,12 @@ def solve_batch(arm, targets, theta0, method="dls", tol=1e-3, max_iter=1000,
 
     A spatial chain takes 4x4 pose targets too: targets (B, 4, 4), with weights as in ik.solve.
     Same loop and stop rules as ik.solve (no trace is kept); method must be a name or a
-    step function written with jax.numpy. stop_rule, joint_limits, limit_mode, levels,
+    step function written with jax.numpy. Every row ends where ik.solve ends from the same
+    start, to the bit (tests/test_batch.py: every method on planar, spatial and pose targets,
+    trees, priority levels and joint limits, batches of 12). The queue's arithmetic is
+    vectorised over its slots; at several hundred slots XLA may vectorise some sums of pose and
+    tree tasks differently, and their last bits can then differ (seen: 2e-15 rad for SDLS on
+    UR5 poses, 1,100 targets; a JT run to max_iter amplifies it). stop_rule, joint_limits, limit_mode, levels,
     rest_pose and rest_gain as in ik.solve.
     """
     method = resolve_method(method)

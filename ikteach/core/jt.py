@@ -11,9 +11,10 @@ def optimal_alpha(J, e):
     is equally good; 0 is returned so the step is 0, never NaN.
     """
     v = J @ (J.T @ e)
-    vv = jnp.dot(v, v)
+    ev, vv = jnp.stack([e, v]) @ v  # <e, v>, <v, v>: one matrix-vector product, summed in
+    # the same order in ik.solve and in ik.solve_batch's vectorised queue (jnp.dot is not)
     safe = jnp.where(vv > 0, vv, 1.0)
-    return jnp.where(vv > 0, jnp.dot(e, v) / safe, 0.0)
+    return jnp.where(vv > 0, ev / safe, 0.0)
 
 
 @jax.jit
