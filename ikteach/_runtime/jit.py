@@ -15,7 +15,9 @@ buy speed and can each be turned off without changing a result.
    programs have been compiled since the last clear, JAX's caches are cleared with its public
    jax.clear_caches(): the programs still in use compile again, or load from JAX's persistent
    compilation cache when ik.notebook.setup() turned it on (benchmarks/many_programs.py shows
-   mappings and memory levelling off). IKTEACH_MAX_PROGRAMS=0 turns the bound off.
+   mappings and memory levelling off). MAX_PROGRAMS = 192 is about 27,000 mappings, well under
+   the limit, and above the 6 methods x 12 joint counts x 2 dimensions a whole course uses (a
+   lower bound would clear and recompile over and over). IKTEACH_MAX_PROGRAMS=0 turns it off.
 """
 import functools
 import inspect
@@ -27,7 +29,7 @@ import jax
 OPTIONS_ENV = "IKTEACH_XLA_OPTIONS"
 BOUND_ENV = "IKTEACH_MAX_PROGRAMS"
 FAST_COMPILE = {"xla_cpu_use_fusion_emitters": False}
-MAX_PROGRAMS = 96
+MAX_PROGRAMS = 192
 
 
 def supported(options):
