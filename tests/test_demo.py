@@ -106,3 +106,41 @@ def test_displayed_widget_carries_a_still_for_static_pages(demo):
 def test_padded_repeats_the_last_row():
     out = ikdemo.padded(np.arange(6.0).reshape(3, 2), 5)
     np.testing.assert_array_equal(out, [[0, 1], [2, 3], [4, 5], [4, 5], [4, 5]])
+
+
+# what each preset is for, with the demo's defaults (dls, lambda 0.5): lectures 04 and 05
+PRESET_STATUS = {"reachable": "converged", "near the edge": "converged", "unreachable": "stalled"}
+
+
+@pytest.mark.parametrize("name", list(ikdemo.PRESETS))
+def test_each_preset_lies_on_the_slider_grid_and_shows_what_it_was_chosen_for(demo, name):
+    demo.update(method="dls", damping=0.5)
+    for v in ikdemo.PRESETS[name]:  # where the browser's slider snaps it: min + k * step
+        snapped = demo.x.min + round((v - demo.x.min) / demo.x.step) * demo.x.step
+        assert abs(snapped - v) < 1e-9, (name, v, snapped)
+    demo.preset.value = name
+    assert (demo.x.value, demo.y.value) == ikdemo.PRESETS[name]
+    assert demo.result.status == PRESET_STATUS[name]
+    ref = ik.solve(ARM, ikdemo.PRESETS[name], START, method="dls", damping=0.5, max_iter=300)
+    assert (demo.result.status, demo.result.iterations) == (ref.status, ref.iterations)
+
+
+def test_a_browser_echo_of_the_same_value_re_solves_nothing(demo):
+    demo.preset.value = "near the edge"
+    solved = demo.result
+    demo.x.value = ikdemo.PRESETS["near the edge"][0] + 4e-16  # the slider's float, sent back
+    assert demo.result is solved
+    demo.x.value = 2.5  # a real move still re-solves
+    assert demo.result is not solved
+
+
+def test_targets_given_off_the_grid_are_rounded_to_it_like_the_slider(demo):
+    demo.update(x=2.987, y=0.4449)
+    assert (demo.x.value, demo.y.value) == (2.99, 0.44)
+
+
+def test_the_image_has_an_accessible_name_and_every_control_a_label(demo):
+    demo.update(x=1.0, y=1.5)
+    assert demo.image.tooltip == demo.alt  # the <img>'s title
+    for control in (demo.x, demo.y, demo.damping, demo.method, *demo.preset.children):
+        assert control.description.strip()

@@ -11,21 +11,22 @@ lambda are traced numbers), so a change costs a few milliseconds of solving plus
 PNG render. Without a browser, call update() and read .result, .summary, .png.
 
 The image is SIZE x SIZE CSS pixels beside its controls (fits a 1280x720 laptop screen
-with JupyterLab around it), rendered at HIDPI times that so it stays sharp on HiDPI
+with JupyterLab around it; narrower, at 200 % zoom, the controls wrap under it and the image
+shrinks to the page's width), rendered at HIDPI times that so it stays sharp on HiDPI
 screens. Only the moving artists are redrawn over a cached background (blitting), and
 the PNG is written with light compression. Displayed, the widget also carries a still
 (PNG + status line) that static pages (GitHub, nbconvert HTML) show in its place.
-"""
-import base64
-import html
-import struct
-import zlib
 
+The target sliders move in steps of STEP and every preset lies on that grid: the browser
+snaps a slider to its grid and sends the snapped value back, so an off-grid preset would be
+re-solved at another target (and, during Run All, after later cells had moved on).
+"""
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from . import plot
+from .stills import png, still_html, with_still  # noqa: F401  (ik.demo.png, .still_html)
 from ..core.chain import planar_chain, reach
 from ..core.solve import solve
 
@@ -35,6 +36,7 @@ PRESETS = {
     "unreachable": (3.5, 1.0),
 }
 METHOD_NAMES = ("dls", "pinv", "jt")
+STEP = 0.01         # the target sliders' step; presets lie on this grid (see on_grid)
 SIZE = 400          # CSS pixels, the image's width and height on the page
 HIDPI = 2           # rendered at HIDPI x SIZE pixels
 CONTROLS_WIDTH = 370  # CSS pixels, the column of sliders, presets and status beside the image
@@ -53,31 +55,9 @@ def alt_text(arm, target, line):
             f"orange dots trace the end effector's path. {line}.")
 
 
-def png(rgba):
-    """An (h, w, 3 or 4) uint8 image as RGB PNG bytes, written for speed: no row filter and
-    zlib's run-length strategy (a plot is mostly runs of one colour), several times faster
-    than a general-purpose PNG encoder at a similar size."""
-    rgb = np.asarray(rgba)[..., :3]
-    h, w, _ = rgb.shape
-    rows = np.zeros((h, 3 * w + 1), dtype=np.uint8)  # each row: filter byte 0, then pixels
-    rows[:, 1:] = rgb.reshape(h, -1)
-    packer = zlib.compressobj(6, zlib.DEFLATED, 15, 9, zlib.Z_RLE)
-    pixels = packer.compress(rows.tobytes()) + packer.flush()
-
-    def chunk(kind, data):
-        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
-
-    header = struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0)  # 8-bit RGB, no interlace
-    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", pixels) + chunk(b"IEND", b"")
-
-
-def still_html(png_bytes, alt, line, size=SIZE):
-    """The demo as static HTML: its image with alt text and the status line under it."""
-    data = base64.b64encode(png_bytes).decode("ascii")
-    return (f'<figure style="margin:0"><img src="data:image/png;base64,{data}" '
-            f'width="{size}" height="{size}" alt="{html.escape(alt)}">'
-            f"<figcaption><code>{html.escape(line)}</code> (a still: run the notebook to "
-            f"drag the target)</figcaption></figure>")
+def on_grid(value, start, step=STEP):
+    """value rounded to the grid start + k * step, as a slider with that step snaps it."""
+    return round(start + round((float(value) - start) / step) * step, 10)
 
 
 def padded(thetas, n):
@@ -113,15 +93,7 @@ def _widgets():
             self._value = name
             self._choose(name)
 
-    class DemoBox(w.HBox):
-        """The demo's layout; in a static view its still (image + status) stands in."""
-
-        def _repr_mimebundle_(self, **kwargs):
-            data = super()._repr_mimebundle_(**kwargs)
-            png_bytes, alt, line = self.still()
-            data.update({"text/plain": line, "text/html": still_html(png_bytes, alt, line),
-                         "image/png": base64.b64encode(png_bytes).decode("ascii")})
-            return data, {"image/png": {"width": SIZE, "height": SIZE, "alt": alt}}
+    DemoBox = with_still(w.HBox)  # the demo's layout; a static view shows its still
 
     return w, PresetButtons, DemoBox
 
@@ -135,28 +107,38 @@ class Demo:
         self.arm = planar_chain([1.0, 1.0, 1.0]) if arm is None else arm
         self.theta0 = np.asarray(theta0, dtype=float)
         self.tol, self.max_iter, self.clamp = tol, max_iter, clamp
-        r = 1.3 * float(reach(self.arm))
-        full = w.Layout(width="100%")
+        self.lo = -on_grid(1.3 * float(reach(self.arm)), 0.0)  # the target sliders' minimum
         style = {"description_width": "62px"}
-        slider = dict(min=-r, max=r, step=0.05, continuous_update=True, readout_format=".2f",
-                      layout=full, style=style)
-        self.x = w.FloatSlider(value=float(target[0]), description="target x", **slider)
-        self.y = w.FloatSlider(value=float(target[1]), description="target y", **slider)
-        self.damping = w.FloatSlider(value=damping, min=0.0, max=2.0, step=0.05, layout=full,
-                                     style=style, description="λ (dls)", readout_format=".2f")
+        # width auto, not 100 %: a slider's margins on top of 100 % overflowed the column
+        # (the stray horizontal scrollbar under the demo)
+        slider = dict(min=self.lo, max=-self.lo, step=STEP, continuous_update=True,
+                      readout_format=".2f", layout=w.Layout(width="auto"), style=style)
+        self.x = w.FloatSlider(value=on_grid(target[0], self.lo), description="target x",
+                               tooltip="x of the target the arm reaches for", **slider)
+        self.y = w.FloatSlider(value=on_grid(target[1], self.lo), description="target y",
+                               tooltip="y of the target the arm reaches for", **slider)
+        self.damping = w.FloatSlider(value=damping, min=0.0, max=2.0, step=0.05,
+                                     layout=w.Layout(width="auto"), style=style,
+                                     description="λ (dls)", readout_format=".2f",
+                                     tooltip="damping lambda of damped least squares")
         self.method = w.Dropdown(options=list(METHOD_NAMES), value=method, description="method",
-                                 style=style)
+                                 style=style, layout=w.Layout(width="auto"))
         self.preset = PresetButtons(PRESETS, self._preset_chosen)
-        px = f"{SIZE}px"
+        # SIZE px wide, at most the page's width (200 % zoom); height follows the width
         self.image = w.Image(format="png", width=str(SIZE), height=str(SIZE),
-                             layout=w.Layout(width=px, height=px, min_width=px, flex="0 0 auto"))
-        self.text = w.Label(layout=full)
+                             layout=w.Layout(width=f"{SIZE}px", max_width="100%", height="auto",
+                                             flex="0 1 auto"))
+        self.text = w.Label(layout=w.Layout(width="auto"))
         controls = w.VBox([self.x, self.y, self.damping, self.method, w.Label("presets"),
                            self.preset, self.text],
-                          layout=w.Layout(width=f"{CONTROLS_WIDTH}px", flex="0 0 auto"))
+                          layout=w.Layout(width=f"{CONTROLS_WIDTH}px", max_width="100%",
+                                          flex="0 1 auto"))
         self.widget = DemoBox([self.image, controls],
-                              layout=w.Layout(flex_flow="row wrap", align_items="flex-start"))
-        self.widget.still = lambda: (self.png, self.alt, self.summary)
+                              layout=w.Layout(flex_flow="row wrap", align_items="flex-start",
+                                              max_width="100%"))
+        self.widget.still = lambda: (self.png, self.alt, self.summary, SIZE, SIZE,
+                                     "drag the target")
+        self._solved = None  # (x, y, damping, method) of the last solve
         self._build_figure(target)
         self._holding = False
         for control in (self.x, self.y, self.damping, self.method):
@@ -185,8 +167,17 @@ class Demo:
         self._canvas.draw()
         self._background = self._canvas.copy_from_bbox(self._fig.bbox)
 
+    def _state(self):
+        return (self.x.value, self.y.value, self.damping.value, self.method.value)
+
     def _changed(self, _change):
-        if not self._holding:
+        """A control moved. A browser echoing back what the kernel set (the same value up to
+        rounding) re-solves nothing."""
+        if self._holding or self._solved is None:
+            return
+        same = all(a == b if isinstance(a, str) else abs(a - b) < 1e-9
+                   for a, b in zip(self._state(), self._solved))
+        if not same:
             self.update()
 
     def _preset_chosen(self, name):
@@ -194,7 +185,9 @@ class Demo:
         self.update(x=x, y=y)
 
     def update(self, x=None, y=None, damping=None, method=None):
-        """Set any controls given, then solve once and redraw. Returns the Result."""
+        """Set any controls given (x and y rounded to the sliders' grid, as a slider would),
+        then solve once and redraw. Returns the Result."""
+        x, y = (None if v is None else on_grid(v, self.lo) for v in (x, y))
         self._holding = True
         try:
             for control, value in ((self.x, x), (self.y, y), (self.damping, damping),
@@ -212,6 +205,8 @@ class Demo:
         self.text.value = self.summary
         self.png = self._draw(target)
         self.image.value = self.png
+        self.image.tooltip = self.alt  # the <img>'s title: its name for a screen reader
+        self._solved = self._state()
         return self.result
 
     def _draw(self, target):
