@@ -42,3 +42,53 @@ def test_live_map_recomputes_on_a_new_lambda_and_keeps_a_png():
     live.update(method="jt", quantity="status")
     assert live.result.method == "jt"
     assert ik.live_map is live_map  # lazy attribute of the package
+
+
+@pytest.fixture
+def counted(monkeypatch):
+    """LiveMap on a small grid, counting the grid solves it runs."""
+    calls = []
+    real = live_map.sweep
+
+    def sweep(*args, **kwargs):
+        calls.append(kwargs["method"])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(live_map, "sweep", sweep)
+    return live_map.LiveMap(ARM, grid_n=12, max_iter=50), calls
+
+
+def test_lambda_under_jt_and_a_new_quantity_re_solve_nothing(counted):
+    live, calls = counted
+    live.update(method="jt")
+    jt = live.result
+    assert calls == ["dls", "jt"]
+    live.damping.value = 1.3  # JT ignores lambda: the same map, redrawn
+    live.update(quantity="status")
+    assert calls == ["dls", "jt"] and live.result is jt
+    assert "no λ" in live.summary
+    live.update(method="dls", damping=0.5)  # the first map: kept
+    assert calls == ["dls", "jt"]
+    live.damping.value = 0.1  # dls with a new lambda: solved
+    assert calls == ["dls", "jt", "dls"]
+
+
+def test_the_map_has_a_fixed_css_size_rendered_at_hidpi_and_a_still():
+    import base64
+    import io
+
+    from PIL import Image
+
+    live = live_map.LiveMap(ARM, grid_n=12, max_iter=50)
+    assert Image.open(io.BytesIO(live.png)).size == (live_map.HIDPI * live_map.SIZE,) * 2
+    # a fixed width (never stretched to the page), at most the page's width
+    assert live.image.layout.width == f"{live_map.SIZE}px"
+    assert live.image.layout.max_width == "100%"
+    data, meta = live.widget._repr_mimebundle_()
+    assert "application/vnd.jupyter.widget-view+json" in data
+    assert base64.b64decode(data["image/png"]) == live.png
+    assert meta["image/png"]["alt"] == live.alt == live.image.tooltip
+    assert "Workspace map" in live.alt and live.summary in live.alt
+    assert 'alt="Workspace map' in data["text/html"]
+    for control in (live.damping, live.method, live.quantity):
+        assert control.description.strip()

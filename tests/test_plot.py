@@ -196,17 +196,25 @@ def test_save_gif_writes_every_frame_as_drawn_by_frame_pngs(tmp_path):
     from PIL import Image
 
     anim = _animation("clips")
-    path = plot.save_gif(anim, tmp_path / "walk.gif", fps=5, dpi=40)
+    path = plot.save_gif(anim, tmp_path / "walk.gif", fps=5, dpi=80)
     gif = Image.open(path)
     assert gif.n_frames == len(anim.iterations) == 5 and gif.info["duration"] == 200
-    assert gif.size == (round(7.2 * 40), round(5.8 * 40))
+    assert gif.size == (round(7.2 * 80), round(5.8 * 80))
     dpi = anim._fig.dpi
-    assert dpi != 40  # the figure's own dpi is given back
+    assert dpi != 80  # the figure's own dpi is given back
     gif.seek(2)
-    anim._fig.set_dpi(40)
+    anim._fig.set_dpi(80)
     png = _png_pixels(plot.frame_pngs(anim)[2])
     anim._fig.set_dpi(dpi)
     assert np.abs(np.asarray(gif.convert("RGB"), float) - png[..., :3]).mean() < 8  # palette
+
+
+def html_alt(anim):
+    import html
+
+    from ikteach.pictures import frames
+
+    return html.escape(frames.animation_alt(anim), quote=True)
 
 
 def test_to_html_embeds_the_blitted_frames_and_plays_like_to_jshtml():
@@ -219,5 +227,56 @@ def test_to_html_embeds_the_blitted_frames_and_plays_like_to_jshtml():
     def page(h):  # the HTML and script around the frames, ids made equal
         return re.sub(r"[0-9a-f]{32}", "ID", re.sub(r"data:image/png;base64,[A-Za-z0-9+/=\\\n]+", "PNG", h))
 
-    assert page(html) == page(reference)
+    assert page(html) == page(reference.replace("<img id=", f'<img alt="{html_alt(anim)}" id=', 1))
     assert plot.embed_size(anim) == len(html.encode())
+
+
+@pytest.mark.parametrize("kind", ["solve", "race", "tree", "clips"])
+def test_text_in_every_animation_is_at_least_10_px_at_the_notebooks_dpi(kind):
+    anim = _animation(kind)
+    assert plot.smallest_text_px(anim._fig, dpi=80) >= plot.MIN_TEXT_PX - 0.5  # ik.notebook: 80
+
+
+def test_save_gif_refuses_a_dpi_that_makes_text_unreadable(tmp_path):
+    anim = _animation("clips")
+    with pytest.raises(ValueError, match="dpi"):
+        plot.save_gif(anim, tmp_path / "tiny.gif", dpi=50)  # 10 pt text: 7 px
+
+
+@pytest.mark.parametrize("kind", ["solve", "tree"])
+def test_an_animations_moving_picture_has_alt_text(kind):
+    import re
+
+    anim = _animation(kind)
+    page = plot.to_html(anim)
+    tags = re.findall(r"<img\b[^>]*>", page)
+    assert tags and all(re.search(r'alt="Animation, \d+ frames\. [^"]+"', t) for t in tags)
+
+
+def test_a_gif_view_carries_its_alt_text_and_needs_one(tmp_path):
+    anim = _animation("clips")
+    gif = plot.save_gif(anim, tmp_path / "walk.gif").read_bytes()
+    data, meta = \
+        plot.gif_view(gif, "two walkers")._repr_mimebundle_()
+    assert 'alt="two walkers" src="data:image/gif;base64,' in data["text/html"]
+    assert meta["image/png"]["alt"].endswith("two walkers")
+    with pytest.raises(ValueError, match="alt"):
+        plot.gif_view(gif, " ")
+
+
+@pytest.mark.parametrize("every, repeats", [(6, True), (7, False)])
+def test_the_walk_gif_repeats_frames_when_its_step_divides_the_gait_cycle(every, repeats):
+    """The walk repeats every CYCLE s (30 frames) and the camera follows the hips: every 6th
+    frame shows 5 poses over and over; every 7th frame never the same pose twice in 150."""
+    from ikteach.characters import bvh, skeleton
+    from ikteach.pictures import character_plot
+
+    sk, motion = bvh.load(bvh.walk_path())
+    rig = skeleton.rig(sk)
+    root, theta = skeleton.angles(rig, motion.frames)
+    points = skeleton.world_points(rig, root, theta)
+    anim = character_plot.animate_clips(rig, [points], ["walk"], root, every=every,
+                                        close_up=False)
+    anim._fig.set_dpi(30)
+    frames = [image.tobytes() for image in plot.frame_images(anim)]
+    assert (len(set(frames)) < len(frames)) == repeats

@@ -1,12 +1,25 @@
 """Animations as pictures: lay a figure out once, draw its frames (only what moves is
 redrawn), encode them as PNGs, GIFs or a playable HTML animation, and show one in a notebook
-with its still frame and alt text. ik.plot re-exports these (ik.plot.show, ik.plot.save_gif).
+with its still frame and alt text. ik.plot re-exports these (ik.plot.show, ik.plot.save_gif,
+ik.plot.gif_view). Text in a frame is at least MIN_TEXT_PX pixels tall (smallest_text_px).
 """
 import io
 
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.animation import FuncAnimation
+
+MIN_TEXT_PX = 10  # the smallest text an animation or GIF may show, in pixels (9 pt at 80 dpi)
+
+
+def smallest_text_px(fig, dpi=None):
+    """The height in pixels of the smallest visible text in a figure drawn at dpi (default:
+    the figure's): font size in points x dpi / 72. Tick labels count, empty texts do not."""
+    from matplotlib.text import Text
+
+    fig.canvas.draw()  # makes the tick labels
+    sizes = [t.get_fontsize() for t in fig.findobj(Text) if t.get_visible() and t.get_text()]
+    return min(sizes) * (dpi or fig.dpi) / 72 if sizes else None
 
 
 def fixed_layout(fig):
@@ -94,10 +107,16 @@ def frame_images(anim, each=None):
 
 def save_gif(anim, path, fps=5, dpi=None):
     """Write an animation made here as a looping GIF, its frames from frame_images (what stays
-    still drawn once), like anim.save(path, writer="pillow", fps=fps, dpi=dpi)."""
+    still drawn once), like anim.save(path, writer="pillow", fps=fps, dpi=dpi). A dpi at which
+    the figure's smallest text would be under MIN_TEXT_PX pixels is a ValueError."""
     from PIL import Image
 
     fig = anim._fig
+    small = smallest_text_px(fig, dpi)
+    if small is not None and small < MIN_TEXT_PX - 0.5:
+        least = MIN_TEXT_PX * (dpi or fig.dpi) / small
+        raise ValueError(f"dpi: {dpi} draws text {small:.1f} px tall, under {MIN_TEXT_PX} px; "
+                         f"use a dpi of at least {least:.0f}")
     old_dpi = fig.dpi
     if dpi is not None:
         fig.set_dpi(dpi)
@@ -119,11 +138,27 @@ def _in_draw_order(fig, artists):
     return sorted(artists, key=lambda artist: rank.get(id(artist), (len(fig.axes), 0, 0)))
 
 
+def animation_alt(anim):
+    """Alt text of an animation's moving picture: its figure's titles and labels, frame count."""
+    from .alt_text import figure_alt
+
+    frames = len(getattr(anim, "iterations", ())) or "several"
+    return f"Animation, {frames} frames. {figure_alt(anim._fig)}"
+
+
+def _with_alt(page, alt):
+    """matplotlib's JavaScript animation shows its frames in an <img> without alt: add it."""
+    import html
+
+    return page.replace("<img id=", f'<img alt="{html.escape(alt, quote=True)}" id=', 1)
+
+
 def to_html(anim, default_mode="loop"):
     """The animation as playable JavaScript HTML, like anim.to_jshtml() but with frames from
-    frame_pngs (each frame draws only what moves); other animations use to_jshtml."""
+    frame_pngs (each frame draws only what moves) and alt text on its <img>; other
+    animations use to_jshtml."""
     if not hasattr(anim, "draw_frame"):
-        return anim.to_jshtml(default_mode=default_mode)
+        return _with_alt(anim.to_jshtml(default_mode=default_mode), animation_alt(anim))
     import base64
     import tempfile
     from pathlib import Path
@@ -137,7 +172,7 @@ def to_html(anim, default_mode="loop"):
         writer.setup(anim._fig, path, dpi=anim._fig.dpi)
         writer._saved_frames = frames
         writer.finish()
-        return path.read_text()
+        return _with_alt(path.read_text(), animation_alt(anim))
 
 
 def show(anim, frame=None):
@@ -155,3 +190,40 @@ def show(anim, frame=None):
 def embed_size(anim):
     """Size in bytes of the animation as embedded JavaScript HTML (to keep under the limit)."""
     return len(to_html(anim).encode())
+
+
+class GifView:
+    """A GIF for a notebook: an animated <img> with alt text (text/html) and its last frame as
+    a PNG (image/png, with the same alt) for static renderers that drop HTML."""
+
+    def __init__(self, gif, alt):
+        from pathlib import Path
+
+        if not alt or not str(alt).strip():
+            raise ValueError("alt: a GIF needs a text that says what it shows")
+        self.gif = gif if isinstance(gif, bytes) else Path(gif).read_bytes()
+        self.alt = alt
+
+    def last_frame_png(self):
+        from PIL import Image
+
+        with Image.open(io.BytesIO(self.gif)) as im:
+            im.seek(im.n_frames - 1)
+            buf = io.BytesIO()
+            im.convert("RGB").save(buf, format="png")
+        return buf.getvalue()
+
+    def _repr_mimebundle_(self, **kwargs):
+        import base64
+        import html
+
+        data = base64.b64encode(self.gif).decode("ascii")
+        tag = f'<img alt="{html.escape(self.alt, quote=True)}" src="data:image/gif;base64,{data}"/>'
+        png = base64.b64encode(self.last_frame_png()).decode("ascii")
+        return ({"text/html": tag, "image/png": png, "text/plain": f"GIF: {self.alt}"},
+                {"image/png": {"alt": f"Last frame of the GIF. {self.alt}"}})
+
+
+def gif_view(gif, alt):
+    """Display a GIF (bytes or a path) in a notebook with alt text and a static fallback."""
+    return GifView(gif, alt)

@@ -6,10 +6,14 @@ with ik.solve_batch and redraw the map (iterations, final error or status) as a 
     live.png, live.still()            # the current picture; as HTML with alt text (static viewers)
 
 The batch is compiled once per method; a new lambda is a traced number, so a change costs
-one solve_batch over the grid and one small PNG render.
-"""
-import io
+one solve_batch over the grid and one small PNG render. Maps are kept per method and lambda
+(the JT map once: lambda does not change it), so moving lambda under JT, switching back to a
+method seen before or changing what is shown re-solves nothing.
 
+The map is SIZE x SIZE CSS pixels (at most the page's width), rendered at HIDPI times that;
+only the map and its title are redrawn over a cached background. Displayed, the widget also
+carries a still (PNG with alt text + status line) that static pages show in its place.
+"""
 import numpy as np
 
 from ..core.chain import planar_chain
@@ -18,6 +22,10 @@ from .workspace_maps import status_image
 
 QUANTITIES = ("iterations", "error", "status")
 MAP_METHODS = ("dls", "jt")  # pinv, sdls: an SVD per step, seconds per map
+DAMPED = ("dls", "sdls")     # the methods whose map lambda changes
+SIZE = 360    # CSS pixels, the map's width and height on the page
+HIDPI = 2     # rendered at HIDPI x SIZE pixels
+KEPT = 64     # maps kept (per method and lambda) before the oldest is dropped
 
 
 def map_image(result, quantity):
@@ -41,49 +49,88 @@ def compute_map(arm, grid, theta0, method="dls", damping=0.5, quantity="iteratio
 def _label(quantity, max_iter):
     return {"iterations": f"iterations, dark 0 to yellow {max_iter}",
             "error": "log10 of the final |e|, dark small to yellow large",
-            "status": "green converged, orange stalled, red max_iter, black diverged"}[quantity]
+            "status": "green converged, orange stalled,\nred max_iter, black diverged"}[quantity]
 
 
 class LiveMap:
-    """lambda slider, method and quantity dropdowns; each change recomputes the map."""
+    """lambda slider, method and quantity dropdowns; each change redraws the map, solving
+    only a map not solved before."""
 
     def __init__(self, arm=None, grid_n=128, theta0=(0.3, 0.3, 0.3), method="dls",
                  damping=0.5, quantity="iterations", tol=1e-3, max_iter=100):
         import ipywidgets as w
-        from matplotlib.figure import Figure
+
+        from .stills import with_still
 
         self.arm = planar_chain([1.0, 1.0, 1.0]) if arm is None else arm
         self.grid = target_grid(self.arm, n=grid_n)
         self.theta0 = np.asarray(theta0, dtype=float)
         self.tol, self.max_iter = tol, max_iter
+        self._maps = {}  # (method, lambda or None) -> SweepMap
+        style = {"description_width": "auto"}
         self.damping = w.FloatSlider(value=damping, min=0.0, max=2.0, step=0.05,
-                                     description="λ (dls)", readout_format=".2f")
-        self.method = w.Dropdown(options=list(MAP_METHODS), value=method, description="method")
-        self.quantity = w.Dropdown(options=list(QUANTITIES), value=quantity, description="show")
-        self.image = w.Image(format="png")
+                                     description="λ (dls)", readout_format=".2f", style=style,
+                                     tooltip="damping lambda of damped least squares")
+        self.method = w.Dropdown(options=list(MAP_METHODS), value=method, description="method",
+                                 style=style, layout=w.Layout(width="auto"))
+        self.quantity = w.Dropdown(options=list(QUANTITIES), value=quantity, description="show",
+                                   style=style, layout=w.Layout(width="auto"))
+        # a fixed CSS size (not stretched to the page), at most the page's width
+        self.image = w.Image(format="png", width=str(SIZE), height=str(SIZE),
+                             layout=w.Layout(width=f"{SIZE}px", max_width="100%", height="auto"))
         self.text = w.Label()
-        self.widget = w.VBox([w.HBox([self.damping, self.method, self.quantity]), self.text,
-                              self.image])
-        self._fig = Figure(figsize=(4.2, 4.2), dpi=80)
-        self._ax = self._fig.add_axes((0.13, 0.1, 0.83, 0.79))
-        self._im = self._ax.imshow(np.zeros(self.grid.shape), origin="lower",
-                                   extent=self.grid.extent, interpolation="nearest")
-        self._ax.set_aspect("equal")
-        self._ax.set_xlabel("target x", fontsize=8)
-        self._ax.set_ylabel("target y", fontsize=8)
-        self._ax.grid(False)
-        self._title = self._ax.set_title("", fontsize=8)
+        controls = w.HBox([self.damping, self.method, self.quantity],
+                          layout=w.Layout(flex_flow="row wrap", max_width="100%"))
+        self.widget = with_still(w.VBox)([controls, self.text, self.image],
+                                         layout=w.Layout(max_width="100%"))
+        self.widget.still = lambda: (self.png, self.alt, self.summary, SIZE, SIZE,
+                                     "move lambda or switch the method")
+        self._build_figure()
         self._holding = False
         for control in (self.damping, self.method, self.quantity):
             control.observe(self._changed, names="value")
         self.update()
 
+    def _build_figure(self):
+        """Axes, labels and ticks drawn once as a cached background; the map and its title
+        are drawn over it on each update."""
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+
+        inches = SIZE / 100  # text in points is then points * 100 / 72 CSS pixels
+        self._fig = Figure(figsize=(inches, inches), dpi=100 * HIDPI)
+        self._canvas = FigureCanvasAgg(self._fig)
+        self._ax = ax = self._fig.add_axes((0.15, 0.11, 0.8, 0.71))
+        self._im = ax.imshow(np.zeros(self.grid.shape), origin="lower", extent=self.grid.extent,
+                             interpolation="nearest")
+        ax.set_aspect("equal")
+        ax.set_xlabel("target x", fontsize=9)
+        ax.set_ylabel("target y", fontsize=9)
+        ax.tick_params(labelsize=8)
+        ax.grid(False)
+        self._title = ax.set_title("", fontsize=9)
+        for artist in (self._im, self._title):
+            artist.set_animated(True)
+        self._canvas.draw()
+        self._background = self._canvas.copy_from_bbox(self._fig.bbox)
+
     def _changed(self, _change):
         if not self._holding:
             self.update()
 
+    def map_for(self, method, damping):
+        """The SweepMap of a method and lambda, solved once (lambda ignored by undamped methods)."""
+        key = (method, round(float(damping), 12) if method in DAMPED else None)
+        if key not in self._maps:
+            if len(self._maps) >= KEPT:
+                self._maps.pop(next(iter(self._maps)))
+            self._maps[key] = sweep(self.arm, self.grid, self.theta0, method=method,
+                                    damping=damping, tol=self.tol, max_iter=self.max_iter)
+        return self._maps[key]
+
     def update(self, damping=None, method=None, quantity=None):
-        """Set any controls given, then recompute and redraw the map. Returns the SweepMap."""
+        """Set any controls given, then redraw the map (solving it only if not solved before).
+        Returns the SweepMap."""
         self._holding = True
         try:
             for control, value in ((self.damping, damping), (self.method, method),
@@ -92,33 +139,41 @@ class LiveMap:
                     control.value = value
         finally:
             self._holding = False
-        self.result, picture = compute_map(
-            self.arm, self.grid, self.theta0, method=self.method.value,
-            damping=self.damping.value, quantity=self.quantity.value, tol=self.tol,
-            max_iter=self.max_iter)
+        method, lam = self.method.value, self.damping.value
+        self.result = self.map_for(method, lam)
         counts = ", ".join(f"{k} {v}" for k, v in self.result.counts().items())
-        self.summary = f"{self.method.value}, λ = {self.damping.value:.2f}: {counts}"
+        shown = f"λ = {lam:.2f}" if method in DAMPED else "no λ"
+        self.summary = f"{method}, {shown}: {counts}"
         self.text.value = self.summary
-        self.png = self._draw(picture)
+        self.alt = (f"Workspace map of {self.grid.shape[0]} x {self.grid.shape[1]} targets, "
+                    f"coloured by {' '.join(_label(self.quantity.value, self.max_iter).split())}; "
+                    f"{self.summary}.")
+        self.png = self._draw(map_image(self.result, self.quantity.value))
         self.image.value = self.png
+        self.image.tooltip = self.alt  # the <img>'s title: its name for a screen reader
         return self.result
 
     def _draw(self, picture):
+        from .stills import png
+
         self._im.set_data(picture)
         if self.quantity.value == "iterations":
             self._im.set_clim(0, self.max_iter)  # the same colours for every lambda
         elif picture.ndim == 2:
             self._im.set_clim(float(picture.min()), float(picture.max()))
-        self._title.set_text(f"{self.method.value}, λ = {self.damping.value:.2f}\n"
+        shown = f"λ = {self.damping.value:.2f}" if self.method.value in DAMPED else "λ unused"
+        self._title.set_text(f"{self.method.value}, {shown}\n"
                              f"{_label(self.quantity.value, self.max_iter)}")
-        buf = io.BytesIO()
-        self._fig.savefig(buf, format="png")
-        return buf.getvalue()
+        self._canvas.restore_region(self._background)
+        self._ax.draw_artist(self._im)
+        self._ax.draw_artist(self._title)
+        return png(self._canvas.buffer_rgba(), filtered=True)
 
     def still(self):
-        """The current map as static HTML (an <img> with alt text), for viewers without a kernel."""
+        """The current map as static HTML (an <img> with alt text), for viewers without a kernel
+        (displaying .widget shows the same still where no kernel runs it)."""
         from IPython.display import HTML
 
-        from .alt_text import figure_alt, img_html
+        from .alt_text import img_html
 
-        return HTML(img_html(self.png, f"Workspace map, {self.summary}. {figure_alt(self._fig)}"))
+        return HTML(img_html(self.png, self.alt))

@@ -25,8 +25,8 @@ from ..core.chain import reach
 from ..core.jacobian import jacobian
 from ..core import kinematics
 from ..core.kinematics import joint_positions
-from .frames import (_animation, embed_size, fixed_layout, frame_images, frame_pngs,  # noqa: F401
-                     save_gif, show, still_png, to_html)
+from .frames import (MIN_TEXT_PX, _animation, embed_size, fixed_layout, frame_images,  # noqa: F401
+                     frame_pngs, gif_view, save_gif, show, smallest_text_px, still_png, to_html)
 
 METHOD_COLORS = {"jt": "C0", "pinv": "C3", "dls": "C2"}
 MAX_FRAMES = 16
@@ -157,7 +157,7 @@ def plot_errors(ax, results, tol=None):
     if tol is not None:
         ax.axhline(tol, color="0.5", ls=":", lw=1, label="tol")
     _error_axis(ax)
-    ax.legend(loc="best", fontsize=8)
+    ax.legend(loc="best", fontsize=9)
     return lines
 
 
@@ -219,7 +219,7 @@ def animate_solve(arm, result, target, max_frames=MAX_FRAMES, title=None, spacin
     path = end_path(arm, result.trace.theta)
     (trail,) = ax.plot([], [], ".-", color="C1", lw=1, ms=3, label="end-effector path")
     arm_artists = draw_arm(ax, arm, result.trace.theta[0], label="arm")
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3, fontsize=7, frameon=False)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3, fontsize=9, frameon=False)
     heading = ax.set_title(title or "", fontsize=9)
     err = np.maximum(result.trace.error, 1e-16)
     ax_err.semilogy(np.arange(err.size), err, "-", color="0.75")
@@ -280,7 +280,7 @@ def animate_race(arm, results, target, max_frames=MAX_FRAMES, spacing="log", fig
         ax_err.set_xscale("symlog", linthresh=10)
         ax_err.xaxis.set_major_formatter(FuncFormatter(lambda x, _: f"{x:.0f}"))
     ax_err.set_xlim(0, longest * 1.05 + 0.5)
-    ax_err.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    ax_err.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=9)
 
     def frame(j):
         k = ks[j]

@@ -6,7 +6,6 @@ static renders off screen to a PNG with alt text; interactive hands the plotter 
 pyvista's trame view (the `3d` extra) in a live kernel.
 """
 import io
-from pathlib import Path
 
 import numpy as np
 
@@ -306,34 +305,8 @@ def solve_gif(arm, trace_theta, path, target=None, frames_max=30, fps=8, window_
     return path
 
 
-class GifView:
-    """A GIF for a notebook: an animated <img> with alt text (text/html) and its last frame as
-    a PNG (image/png, with the same alt) for static renderers that drop HTML."""
-
-    def __init__(self, path, alt):
-        self.gif = Path(path).read_bytes()
-        self.alt = alt
-
-    def last_frame_png(self):
-        from PIL import Image
-
-        with Image.open(io.BytesIO(self.gif)) as im:
-            im.seek(im.n_frames - 1)
-            buf = io.BytesIO()
-            im.convert("RGB").save(buf, format="png")
-        return buf.getvalue()
-
-    def _repr_mimebundle_(self, **kwargs):
-        import base64
-        import html
-
-        data = base64.b64encode(self.gif).decode("ascii")
-        tag = f'<img alt="{html.escape(self.alt, quote=True)}" src="data:image/gif;base64,{data}"/>'
-        png = base64.b64encode(self.last_frame_png()).decode("ascii")
-        return ({"text/html": tag, "image/png": png, "text/plain": f"GIF: {self.alt}"},
-                {"image/png": {"alt": f"Last frame of the GIF. {self.alt}"}})
-
-
 def show_gif(path, alt):
     """Display a GIF written by solve_gif (or any GIF) with alt text and a static fallback."""
+    from .frames import GifView
+
     return GifView(path, alt)

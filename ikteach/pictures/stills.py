@@ -14,14 +14,28 @@ import zlib
 import numpy as np
 
 
-def png(rgba):
-    """An (h, w, 3 or 4) uint8 image as RGB PNG bytes, written for speed: no row filter and
-    zlib's run-length strategy (a plot is mostly runs of one colour), several times faster
-    than a general-purpose PNG encoder at a similar size."""
+def png(rgba, filtered=False):
+    """An (h, w, 3 or 4) uint8 image as RGB PNG bytes, written for speed: zlib's run-length
+    strategy (a plot is mostly runs of one colour), several times faster than a
+    general-purpose PNG encoder at a similar size. No row filter by default (line drawings);
+    filtered=True for blocks of colour such as an upscaled map: each row stores its pixels'
+    differences to their left neighbours (PNG filter 1, "Sub"), or nothing but filter 2
+    ("Up") where it repeats the row above, so repeats become zero runs (the 128 x 128 map at
+    720 x 720 pixels: 490 kB -> 83 kB, and faster)."""
     rgb = np.asarray(rgba)[..., :3]
     h, w, _ = rgb.shape
-    rows = np.zeros((h, 3 * w + 1), dtype=np.uint8)  # each row: filter byte 0, then pixels
-    rows[:, 1:] = rgb.reshape(h, -1)
+    flat = rgb.reshape(h, -1)
+    rows = np.zeros((h, 3 * w + 1), dtype=np.uint8)  # each row: its filter byte, then pixels
+    if filtered:
+        rows[:, 0] = 1
+        rows[:, 1:4] = flat[:, :3]
+        np.subtract(flat[:, 3:], flat[:, :-3], out=rows[:, 4:])  # modulo 256, as PNG wants
+        repeat = np.zeros(h, dtype=bool)
+        repeat[1:] = (flat[1:] == flat[:-1]).all(axis=1)
+        rows[repeat] = 0
+        rows[repeat, 0] = 2
+    else:
+        rows[:, 1:] = flat
     packer = zlib.compressobj(6, zlib.DEFLATED, 15, 9, zlib.Z_RLE)
     pixels = packer.compress(rows.tobytes()) + packer.flush()
 

@@ -41,7 +41,7 @@ def animate_tree(arm, thetas, targets, plane=(0, 1), limits=((-2.5, 4.0), (-1.0,
     lines, joints, effs, tgt = draw_tree(ax, arm, thetas[0], targets[0], plane)
     effs.set_label("end effectors")
     tgt.set_label("targets")
-    ax.legend(loc="upper right", fontsize=8)
+    ax.legend(loc="upper right", fontsize=9)
     i, j = plane
 
     def frame(k):
