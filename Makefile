@@ -28,8 +28,16 @@ $(STAMP): pyproject.toml uv.lock | $(UV)
 # Jupyter refuses to run as root unless told (containers, Binder-like machines).
 LAB_ARGS ?= $(if $(filter 0,$(shell id -u)),--allow-root)
 
-lab: $(STAMP)
-	$(VENV)/bin/jupyter lab --notebook-dir=notebooks $(LAB_ARGS)
+# The lab also gets the `3d` extra (pyvista's trame: interactive 3-D scenes), and asks for live
+# 3-D even without $$DISPLAY (macOS, a remote machine: pyvista renders off screen for trame).
+LAB_STAMP := $(VENV)/.lab-stamp
+$(LAB_STAMP): $(STAMP)
+	$(SYNC) --extra 3d --quiet
+	@touch $(LAB_STAMP)
+
+lab: $(LAB_STAMP)
+	IKTEACH_PYVISTA=$${IKTEACH_PYVISTA:-interactive} \
+		$(VENV)/bin/jupyter lab --notebook-dir=notebooks $(LAB_ARGS)
 
 # Exercise templates (check cells print "not yet implemented") and the instructor's solutions.
 EXERCISES = $(wildcard notebooks/exercises/*.ipynb) $(wildcard instructor/solutions/*.ipynb)

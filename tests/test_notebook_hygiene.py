@@ -258,3 +258,39 @@ def test_setup_prints_one_versions_line(capsys):
     cfg = (ROOT / "tests" / "nbval_sanitize.cfg").read_text()
     regex = re.search(r"\[versions line\]\nregex: (.*)\nreplace: (.*)", cfg)
     assert re.sub(regex.group(1), regex.group(2), lines[0]) == "versions: VERSIONS"
+
+
+GENERIC_ALT = {"", "image", "figure", "animation", "gif"}
+
+
+def _img_tags(nb):
+    """(cell index, <img> tag) for every <img> in an HTML output: stills, the playing image of
+    a JavaScript animation, GIFs, widget stills."""
+    for i, cell in enumerate(nb["cells"]):
+        for output in cell.get("outputs", []):
+            for tag in re.findall(r"<img\b[^>]*>", "".join(output.get("data", {}).get("text/html", []))):
+                yield i, tag
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.relative_to(ROOT).as_posix())
+def test_every_img_and_gif_says_what_it_shows(path):
+    nb = _load(path)
+    for i, tag in _img_tags(nb):
+        alt = re.search(r'alt="([^"]*)"', tag)
+        assert alt and alt.group(1).strip().lower() not in GENERIC_ALT, \
+            f"{path.name} cell {i}: {tag[:80]} has no alt text that says what it shows"
+    for i, cell in enumerate(nb["cells"]):
+        for output in cell.get("outputs", []):
+            assert "image/gif" not in output.get("data", {}), \
+                f"{path.name} cell {i}: a bare GIF (no alt): show it with ik.plot.gif_view"
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.relative_to(ROOT).as_posix())
+def test_a_widget_shows_a_still_where_no_kernel_runs_it(path):
+    """A displayed widget's output carries an image (with alt text): never a bare 'VBox(...)'."""
+    for i, cell in enumerate(_load(path)["cells"]):
+        for output in cell.get("outputs", []):
+            data = output.get("data", {})
+            plain = "".join(data.get("text/plain", []))
+            assert not re.match(r"(VBox|HBox|Box|Image|FloatSlider)\(", plain), \
+                f"{path.name} cell {i}: a widget without a still ({plain[:40]})"

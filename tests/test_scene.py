@@ -150,16 +150,18 @@ def test_interactive_backend_hands_the_plotter_to_pyvista_even_off_screen(backen
     plotter.close()
 
 
-def test_interactive_without_trame_warns_and_stays_static(backend, monkeypatch):
+def test_interactive_without_trame_says_what_to_run_and_stays_static(backend, monkeypatch, capsys):
     def no_trame(name):
         if name != "static":
             raise ImportError("Please install trame dependencies")
         backend.global_theme._jupyter_backend = name
 
     monkeypatch.setattr(backend, "set_jupyter_backend", no_trame)
-    with pytest.warns(UserWarning, match=r"ikteach\[3d\]"):
-        assert backend_3d._setup_pyvista("interactive") == "static"
+    assert backend_3d._setup_pyvista("interactive") == "static"
     assert backend.global_theme.jupyter_backend == "static"
+    said = capsys.readouterr().err
+    assert "make lab" in said and "pip install 'ikteach[3d]'" in said
+    assert "ikteach/" not in said and ".py" not in said  # no path inside the package
 
 
 @pytest.mark.parametrize("choice, headless, expected", [

@@ -7,6 +7,9 @@ import sys
 
 
 PYVISTA_CHOICES = ("static", "interactive")
+NO_TRAME = ("3-D scenes show as static images here: interactive 3-D needs pyvista's trame. "
+            "Open the course with `make lab` (it installs it), or run "
+            "pip install 'ikteach[3d]' and restart the kernel.")
 
 
 def pyvista_backend(choice, headless):
@@ -64,10 +67,7 @@ def _setup_pyvista(choice=None):
             pv.set_jupyter_backend("trame")
             return "trame"
         except ImportError:  # no trame: the `3d` extra is not installed
-            if choice == "interactive":
-                import warnings
-
-                warnings.warn("interactive 3-D needs pyvista's trame backend: pip install "
-                              "'ikteach[3d]'; showing static images", stacklevel=3)
+            # one plain line, not a warning (a warning's first line is a path inside ikteach)
+            print(NO_TRAME, file=sys.stderr)
     pv.set_jupyter_backend("static")
     return "static"
