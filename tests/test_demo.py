@@ -141,6 +141,6 @@ def test_targets_given_off_the_grid_are_rounded_to_it_like_the_slider(demo):
 
 def test_the_image_has_an_accessible_name_and_every_control_a_label(demo):
     demo.update(x=1.0, y=1.5)
-    assert demo.image.tooltip == demo.alt  # the <img>'s title
+    assert not demo.image.tooltip  # ipywidgets 8.1: an Image with a tooltip fails to render
     for control in (demo.x, demo.y, demo.damping, demo.method, *demo.preset.children):
         assert control.description.strip()

@@ -40,6 +40,7 @@ STEP = 0.01         # the target sliders' step; presets lie on this grid (see on
 SIZE = 400          # CSS pixels, the image's width and height on the page
 HIDPI = 2           # rendered at HIDPI x SIZE pixels
 CONTROLS_WIDTH = 370  # CSS pixels, the column of sliders, presets and status beside the image
+FIT = "calc(100% - 4px)"  # a child's widest: the page less its 2 px margins (no scrollbar)
 
 
 def summary(method, result):
@@ -126,12 +127,12 @@ class Demo:
         self.preset = PresetButtons(PRESETS, self._preset_chosen)
         # SIZE px wide, at most the page's width (200 % zoom); height follows the width
         self.image = w.Image(format="png", width=str(SIZE), height=str(SIZE),
-                             layout=w.Layout(width=f"{SIZE}px", max_width="100%", height="auto",
+                             layout=w.Layout(width=f"{SIZE}px", max_width=FIT, height="auto",
                                              flex="0 1 auto"))
         self.text = w.Label(layout=w.Layout(width="auto"))
         controls = w.VBox([self.x, self.y, self.damping, self.method, w.Label("presets"),
                            self.preset, self.text],
-                          layout=w.Layout(width=f"{CONTROLS_WIDTH}px", max_width="100%",
+                          layout=w.Layout(width=f"{CONTROLS_WIDTH}px", max_width=FIT,
                                           flex="0 1 auto"))
         self.widget = DemoBox([self.image, controls],
                               layout=w.Layout(flex_flow="row wrap", align_items="flex-start",
@@ -205,7 +206,8 @@ class Demo:
         self.text.value = self.summary
         self.png = self._draw(target)
         self.image.value = self.png
-        self.image.tooltip = self.alt  # the <img>'s title: its name for a screen reader
+        # no .tooltip on the image: ipywidgets 8.1's ImageView fails to render with one (it
+        # reads a description an Image does not have); the still and the status line carry it
         self._solved = self._state()
         return self.result
 

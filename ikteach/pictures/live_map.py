@@ -77,7 +77,7 @@ class LiveMap:
                                    style=style, layout=w.Layout(width="auto"))
         # a fixed CSS size (not stretched to the page), at most the page's width
         self.image = w.Image(format="png", width=str(SIZE), height=str(SIZE),
-                             layout=w.Layout(width=f"{SIZE}px", max_width="100%", height="auto"))
+                             layout=w.Layout(width=f"{SIZE}px", max_width="calc(100% - 4px)", height="auto"))
         self.text = w.Label()
         controls = w.HBox([self.damping, self.method, self.quantity],
                           layout=w.Layout(flex_flow="row wrap", max_width="100%"))
@@ -150,7 +150,8 @@ class LiveMap:
                     f"{self.summary}.")
         self.png = self._draw(map_image(self.result, self.quantity.value))
         self.image.value = self.png
-        self.image.tooltip = self.alt  # the <img>'s title: its name for a screen reader
+        # no .tooltip on the image: ipywidgets 8.1's ImageView fails to render with one (it
+        # reads a description an Image does not have); the still and the status line carry it
         return self.result
 
     def _draw(self, picture):

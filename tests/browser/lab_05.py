@@ -231,3 +231,32 @@ def test_the_animation_play_button_advances_frames(notebook):
     _shot(notebook, "animation-playing")
     _wait_until(lambda: int(slider.get_attribute("value")) > frame0, 10, "the animation to advance")
     assert controls.find_element(By.TAG_NAME, "img").get_attribute("src") != picture
+
+
+def _overflowing(driver, box):
+    """Boxes inside the demo wider than they show (a horizontal scrollbar), as [scroll, client]."""
+    return _js(driver, "return [arguments[0], ...arguments[0].querySelectorAll('.widget-box')]"
+                       ".filter(b => b.scrollWidth > b.clientWidth + 1)"
+                       ".map(b => [b.className, b.scrollWidth, b.clientWidth])", box)
+
+
+def test_no_stray_scrollbar_and_the_demo_fits_at_200_percent_zoom(notebook):
+    box, image, _, _ = _demo(notebook)
+    assert not _overflowing(notebook, box)  # D6: no horizontal scrollbar at 100 %
+    # 200 % zoom of a 1280x720 window: a 640x360 CSS-pixel page at 2 device pixels each
+    notebook.execute_cdp_cmd("Emulation.setDeviceMetricsOverride",
+                             {"width": WIDTH // 2, "height": HEIGHT // 2, "deviceScaleFactor": 2,
+                              "mobile": False})
+    try:
+        time.sleep(1.0)
+        _js(notebook, "arguments[0].scrollIntoView({block: 'start'})", image)
+        time.sleep(0.5)
+        _shot(notebook, "demo-200-percent")
+        left, right = _js(notebook, "const r = arguments[0].getBoundingClientRect();"
+                                    " return [r.left, r.right]", image)
+        panel = _js(notebook, "const r = document.querySelector('.jp-NotebookPanel .jp-Notebook')"
+                              ".getBoundingClientRect(); return [r.left, r.right]")
+        assert panel[0] <= left and right <= panel[1], (left, right, panel)  # not clipped
+        assert not _overflowing(notebook, box)
+    finally:
+        notebook.execute_cdp_cmd("Emulation.clearDeviceMetricsOverride", {})
