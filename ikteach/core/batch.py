@@ -25,7 +25,7 @@ import numpy as np
 
 from .pinv import DEFAULT_RCOND
 from .sdls import GAMMA_MAX
-from .levels import DEFAULT_REST_GAIN
+from .methods import require_traceable
 from .solve import (DEFAULT_DAMPING, RUNNING, STATUSES, _run_jit, advance, check_problem,
                     initial_state, resolve_method, run_chunks, status_counts, with_extras)
 from .._runtime import jit as runtime_jit
@@ -165,7 +165,7 @@ def solve_batch(arm, targets, theta0, method="dls", tol=1e-3, max_iter=1000,
                 damping=DEFAULT_DAMPING, rcond=DEFAULT_RCOND, clamp=None, max_step=None,
                 stall_tol=None, gamma_max=GAMMA_MAX, weights=None, stop_rule="joint_steps",
                 joint_limits=None, limit_mode=None, levels=None, rest_pose=None,
-                rest_gain=DEFAULT_REST_GAIN):
+                rest_gain=None):
     """Solve for every row of targets (B, d); theta0 is one start (n,) or one per target (B, n).
 
     A spatial chain takes 4x4 pose targets too: targets (B, 4, 4), with weights as in ik.solve.
@@ -176,15 +176,17 @@ def solve_batch(arm, targets, theta0, method="dls", tol=1e-3, max_iter=1000,
     vectorised over its slots; at several hundred slots XLA may vectorise some sums of pose and
     tree tasks differently, and their last bits can then differ (seen: 2e-15 rad for SDLS on
     UR5 poses, 1,100 targets; a JT run to max_iter amplifies it). stop_rule, joint_limits, limit_mode, levels,
-    rest_pose and rest_gain as in ik.solve.
+    rest_pose and rest_gain as in ik.solve. Bad input raises a ValueError as in ik.solve;
+    an empty batch (no rows) too.
     """
     method = resolve_method(method)
     task, targets, theta0, settings, max_iter = check_problem(
         arm, targets, theta0, tol=tol, max_iter=max_iter, damping=damping, rcond=rcond,
         clamp=clamp, max_step=max_step, stall_tol=stall_tol, gamma_max=gamma_max, batch=True,
-        weights=weights, stop_rule=stop_rule)
+        weights=weights, stop_rule=stop_rule, method=method)
     method, settings, theta0 = with_extras(method, task, arm, targets, theta0, settings, levels,
                                            rest_pose, rest_gain, joint_limits, limit_mode, batch=True)
+    require_traceable(method, task, arm, targets[0], theta0.reshape(-1, arm.n_joints)[0], settings)
     if theta0.ndim == 1:
         theta0 = jnp.broadcast_to(theta0, (targets.shape[0], theta0.shape[0]))
     state = _run(method, task, arm, targets, theta0, settings, max_iter)

@@ -19,6 +19,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ._validate import numeric
 from .limits import cap_step, clamp_error
 from .sdls import SDLSMethod, sdls_step
 
@@ -110,8 +111,8 @@ def check_limits(joint_limits, n):
     out = []
     for name, bound, bad in (("lower", lower, np.inf), ("upper", upper, -np.inf)):
         try:
-            arr = np.broadcast_to(np.asarray(bound, dtype=np.float64), (n,)).copy()
-        except (TypeError, ValueError):
+            arr = np.broadcast_to(numeric(bound, "joint_limits"), (n,)).copy()
+        except ValueError:
             raise ValueError(f"joint_limits: expected {name} as a number or shape ({n},) "
                              f"(one per joint), got {bound!r:.80}") from None
         if np.any(np.isnan(arr)) or np.any(arr == bad):
@@ -133,6 +134,9 @@ def with_limits(method, settings, theta0, joint_limits, limit_mode, n):
     if limit_mode not in (None,) + LIMIT_MODES:
         raise ValueError(f"limit_mode: expected one of {LIMIT_MODES}, got {limit_mode!r:.80}")
     if joint_limits is None:
+        if limit_mode is not None:
+            raise ValueError(f"limit_mode: {limit_mode!r} says how to keep joint limits, so it "
+                             f"needs joint_limits=(lower, upper)")
         return method, settings, theta0
     lower, upper = check_limits(joint_limits, n)
     has_jacobian = jacobian_step(method, None, None, settings) is not None

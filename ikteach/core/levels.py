@@ -61,6 +61,9 @@ class PriorityMethod:
 def with_priorities(method, task, arm, target, theta0, settings, levels, rest_pose, rest_gain,
                     is_default):
     """The solve's method and settings with priority levels / a rest pose (unchanged without)."""
+    if rest_pose is None and rest_gain is not None:
+        raise ValueError("rest_gain: the gain of the rest-pose level, so it needs rest_pose= "
+                         "(the pose to drift back to)")
     if levels is None and rest_pose is None:
         return method, settings
     if not is_default:
@@ -70,15 +73,17 @@ def with_priorities(method, task, arm, target, theta0, settings, levels, rest_po
     blocks = rows // block_size(task, rows)
     if levels is None:
         levels = (0,) * blocks
-    try:
-        levels = tuple(int(v) for v in levels)
-    except (TypeError, ValueError):
-        raise ValueError(f"levels: expected one integer priority per target block, got {levels!r:.80}") from None
+    if isinstance(levels, (str, bytes)) or not np.iterable(levels) or any(
+            isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) for v in levels):
+        raise ValueError(f"levels: expected one integer priority per target block "
+                         f"(whole numbers 0, 1, ...), got {levels!r:.80}")
+    levels = tuple(int(v) for v in levels)
     if len(levels) != blocks or min(levels) < 0:
         raise ValueError(f"levels: expected {blocks} priorities >= 0 (one per "
                          f"{'end effector' if blocks > 1 else 'target'}), got {list(levels)}")
     if rest_pose is not None:
         rest_pose = as_array(rest_pose, "rest_pose", shape=(arm.n_joints,))
-        gain = as_number(rest_gain, "rest_gain", minimum=0, strict=True)
+        gain = as_number(DEFAULT_REST_GAIN if rest_gain is None else rest_gain, "rest_gain",
+                         minimum=0, strict=True)
         settings = settings._replace(rest_pose=jnp.asarray(rest_pose), rest_gain=gain)
     return PriorityMethod(levels, rest_pose is not None), settings

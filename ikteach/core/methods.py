@@ -6,6 +6,7 @@ import inspect
 from typing import Callable
 
 import jax
+import jax.numpy as jnp
 
 from .ccd import CCDMethod
 from .dls import dls_step
@@ -48,7 +49,40 @@ class UserStep:
     fn: Callable
 
     def __call__(self, J, e, s):
-        return self.fn(J, e)
+        return check_step(self.fn(J, e))
+
+
+def check_step(delta):
+    """A step function's output as an array of real numbers, or a ValueError naming `method`."""
+    what = "method: the step function must return an array delta_theta (one real number per joint)"
+    if delta is None or isinstance(delta, (str, bytes)):
+        raise ValueError(f"{what}, got {delta!r:.80}")
+    try:
+        delta = jnp.asarray(delta)
+    except TypeError:
+        raise ValueError(f"{what}, got {type(delta).__name__} {delta!r:.80}") from None
+    if jnp.iscomplexobj(delta):
+        raise ValueError(f"{what}, got complex numbers (dtype {delta.dtype})")
+    if delta.dtype == bool or not jnp.issubdtype(delta.dtype, jnp.number):
+        raise ValueError(f"{what}, got dtype {delta.dtype}")
+    return delta
+
+
+def require_traceable(method, task, arm, target, theta0, settings):
+    """solve_batch runs the method under jax.jit and jax.vmap: a ValueError naming `method`
+    when a user's step function cannot be traced (numpy calls, float(), branches on values)."""
+    if built_in(method):
+        return
+    try:
+        jax.eval_shape(lambda q: method.delta(task, arm, target, q, task.error(arm, target, q),
+                                              settings), theta0)
+    except ValueError:
+        raise
+    except Exception as err:
+        raise ValueError(f"method: ik.solve_batch compiles the step function (jax.jit, jax.vmap), "
+                         f"so batch step functions must use jax.numpy, not numpy or Python "
+                         f"branches on values (ik.solve runs either kind); JAX said: "
+                         f"{type(err).__name__}: {str(err).splitlines()[0]:.200}") from err
 
 
 METHODS = {"jt": JacobianMethod(_jt), "pinv": JacobianMethod(_pinv), "dls": JacobianMethod(_dls)}

@@ -14,6 +14,7 @@ import dataclasses
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from ._validate import as_number
 from .chain import Chain, reach
@@ -114,6 +115,9 @@ class PoseTask:
     def target_shape(self, arm):
         return "(4, 4)"
 
+    def check_target(self, target, name):
+        check_pose(target, name)
+
     def error(self, arm, target, theta):
         positions, _, R = joint_frames(arm, theta)
         e_p = target[:3, 3] - positions[-1]
@@ -143,6 +147,33 @@ class PoseTask:
 
 jax.tree_util.register_dataclass(PoseTask, data_fields=["position_weight", "orientation_weight"],
                                  meta_fields=[])
+
+
+RIGID_TOL = 1e-6  # largest |R^T R - I| entry and |bottom row - [0, 0, 0, 1]| accepted
+
+
+def check_pose(T, name="target"):
+    """A ValueError naming `name` unless every 4x4 in T (shape (..., 4, 4), numpy) is a rigid
+    transform [[R, p], [0, 0, 0, 1]]: R^T R = I and det R = +1 (a rotation: no scale, shear
+    or reflection), each to RIGID_TOL."""
+    T = np.asarray(T, dtype=np.float64).reshape(-1, 4, 4)
+    R = T[:, :3, :3]
+    where = lambda k: f"{name}[{k}]" if T.shape[0] > 1 or name == "targets" else name
+    bottom = np.abs(T[:, 3] - [0.0, 0.0, 0.0, 1.0]).max(axis=1)
+    if np.any(bottom > RIGID_TOL):
+        k = int(np.argmax(bottom))
+        raise ValueError(f"{where(k)}: expected a rigid transform with bottom row [0, 0, 0, 1], "
+                         f"got {T[k, 3].tolist()}")
+    off = np.abs(np.swapaxes(R, 1, 2) @ R - np.eye(3)).max(axis=(1, 2))
+    if np.any(off > RIGID_TOL):
+        k = int(np.argmax(off))
+        raise ValueError(f"{where(k)}: expected a rotation in the top-left 3x3 (R^T R = I to "
+                         f"{RIGID_TOL:g}), got R^T R off by {off[k]:.3g} (scaled or sheared)")
+    det = np.linalg.det(R)
+    if np.any(det < 0):
+        k = int(np.argmax(det < 0))
+        raise ValueError(f"{where(k)}: expected a rotation in the top-left 3x3, got a reflection "
+                         f"(det R = {det[k]:.3g})")
 
 
 def pose_errors(arm, theta, target):

@@ -19,8 +19,11 @@ import jax.numpy as jnp
 import numpy as np
 
 from ._validate import as_array, as_count, as_number
+from .ccd import CCDMethod
+from .chain import Chain
+from .fabrik import FABRIKMethod
 from .sdls import GAMMA_MAX
-from .levels import DEFAULT_REST_GAIN, with_priorities
+from .levels import with_priorities
 from .joint_limits import with_limits
 from .limits import cap_step
 from .methods import METHODS, resolve_method, traceable
@@ -234,19 +237,33 @@ def with_extras(method, task, arm, target, theta0, settings, levels, rest_pose, 
     return with_limits(method, settings, theta0, joint_limits, limit_mode, arm.n_joints)
 
 
+def check_method_target(method, task, arm, name="target"):
+    """CCD and FABRIK move the end effector towards a point: position targets on chains only."""
+    kind = {CCDMethod: "ccd", FABRIKMethod: "fabrik"}.get(type(method))
+    if kind is None or not isinstance(arm, Chain) or type(task).__name__ == "PositionTask":
+        return  # (trees: the method's own check, ccd.require_chain, names them)
+    raise ValueError(f"method: {kind!r} works on chains with position targets ({name} of shape "
+                     f"({arm.dim},)), got a 4x4 pose target; use 'jt', 'pinv', 'dls' or 'sdls'")
+
+
 def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, max_step,
                   stall_tol, gamma_max=GAMMA_MAX, batch=False,
-                  weights=None, stop_rule=stop_rules.DEFAULT_STOP_RULE):
-    """Validate everything solve/solve_batch take.
+                  weights=None, stop_rule=stop_rules.DEFAULT_STOP_RULE, method=None):
+    """Validate everything solve/solve_batch take (numbers: see ikteach/core/_validate.py).
 
     Returns (task, target, theta0, settings, max_iter). With batch=True, target holds
-    one target per row and theta0 is (n,) or (B, n).
+    one target per row (at least one row) and theta0 is (n,) or (B, n).
     """
     name = "targets" if batch else "target"
     target = as_array(target, name)
     if batch and target.ndim < 2:
         raise ValueError(f"targets: expected one target per row, got shape {target.shape}")
+    if batch and target.shape[0] == 0:
+        raise ValueError(f"targets: expected at least one target, got none (shape {target.shape})")
     task = task_for(arm, target.shape[1:] if batch else target.shape, name)
+    if hasattr(task, "check_target"):  # pose targets: rigid transforms only
+        task.check_target(target, name)
+    check_method_target(method, task, arm, name)
     if weights is not None:  # pose targets: weights (position, orientation) on the error
         if not hasattr(task, "weighted"):
             raise ValueError("weights: only pose targets (a 4x4 transform for a spatial "
@@ -261,15 +278,17 @@ def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, 
     if max_iter > MAX_ITER_CAP:
         raise ValueError(f"max_iter: expected at most {MAX_ITER_CAP:,} iterations (ik.solve keeps "
                          f"every iterate), got {max_iter:,}")
-    if stall_tol is None:
+    if stall_tol is None:  # the default follows the arm's size (not checked as a user's number)
         stall_tol = STALL_FRACTION * task.length_scale(arm)
+    else:
+        stall_tol = as_number(stall_tol, "stall_tol", minimum=0)
     settings = Settings(
         tol=as_number(tol, "tol", minimum=0, strict=True),
         damping=as_number(damping, "damping", minimum=0),
         rcond=as_number(rcond, "rcond", minimum=0),
         clamp=np.inf if clamp is None else as_number(clamp, "clamp", minimum=0, strict=True),
         max_step=np.inf if max_step is None else as_number(max_step, "max_step", minimum=0, strict=True),
-        stall_tol=as_number(stall_tol, "stall_tol", minimum=0),
+        stall_tol=stall_tol,
         gamma_max=as_number(gamma_max, "gamma_max", minimum=0, strict=True),
         stop_rule=stop_rules.rule_index(stop_rule),
     )
@@ -279,7 +298,7 @@ def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, 
 def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DEFAULT_DAMPING,
           rcond=DEFAULT_RCOND, clamp=None, max_step=None, stall_tol=None, gamma_max=GAMMA_MAX,
           weights=None, stop_rule=stop_rules.DEFAULT_STOP_RULE, joint_limits=None,
-          limit_mode=None, levels=None, rest_pose=None, rest_gain=DEFAULT_REST_GAIN):
+          limit_mode=None, levels=None, rest_pose=None, rest_gain=None):
     """Solve F(theta) = target from theta0 by repeated steps of `method`.
 
     method    "jt", "pinv", "dls", "sdls", "ccd", "fabrik", or a function step(J, e) -> delta_theta
@@ -300,18 +319,29 @@ def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DE
     joint_limits  (lower, upper): per-joint arrays (or numbers), +-inf for no limit; every
               theta of the result and trace stays within them (ikteach/joint_limits.py).
     limit_mode    "clamping_loop" (default for Jacobian methods: pinned joints leave J and
-              the rest re-solves) or "clamp" (clip after the step; any method).
+              the rest re-solves) or "clamp" (clip after the step; any method); only with
+              joint_limits.
+              A start theta0 outside the limits is first moved onto them (clipped joint by
+              joint): the trace starts there, not at theta0.
     levels    priority of each target block, 0 first (one per end effector of a tree; for a
-              pose: position, orientation): each level is solved in the null space of those
-              before it (ikteach/levels.py).  rest_pose: a last level pulling theta towards
-              rest_pose with gain rest_gain in the freedom that is left.
+              pose: position, orientation), whole numbers: each level is solved in the null
+              space of those before it (ikteach/levels.py).  rest_pose: a last level pulling
+              theta towards rest_pose with gain rest_gain (default 0.1, levels.py's
+              DEFAULT_REST_GAIN; only with rest_pose) in the freedom that is left.
     Returns a Result: theta, status, iterations, error (final ||e||) and trace.
+
+    Bad input raises a ValueError naming the parameter: numbers must be real (no booleans,
+    strings or complex), finite and of magnitude at most 1e40, positive sizes (tol, damping,
+    ...) 0 where allowed or at least 1e-100, link lengths 0 or at least 1e-40 (the reasons:
+    ikteach/core/_validate.py); a 4x4 target must be
+    a rigid transform (check_pose in ikteach/core/pose.py); ccd and fabrik take position
+    targets on chains only.
     """
     method = resolve_method(method)
     task, target, theta0, settings, max_iter = check_problem(
         arm, target, theta0, tol=tol, max_iter=max_iter, damping=damping, rcond=rcond,
         clamp=clamp, max_step=max_step, stall_tol=stall_tol, gamma_max=gamma_max,
-        weights=weights, stop_rule=stop_rule)
+        weights=weights, stop_rule=stop_rule, method=method)
     method, settings, theta0 = with_extras(method, task, arm, target, theta0, settings, levels,
                                            rest_pose, rest_gain, joint_limits, limit_mode)
     run = _run_jit if traceable(method, task, arm, target, theta0, settings) else _run_eager

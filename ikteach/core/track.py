@@ -14,10 +14,11 @@ import numpy as np
 from ._validate import as_array, as_number
 from .jitter import jitter
 from .limits import cap_step
+from .methods import require_traceable
 from .pinv import DEFAULT_RCOND
 from .sdls import GAMMA_MAX
-from .levels import DEFAULT_REST_GAIN
-from .solve import DEFAULT_DAMPING, Settings, linearize, resolve_method, with_extras
+from .solve import (DEFAULT_DAMPING, Settings, check_method_target, linearize, resolve_method,
+                    with_extras)
 from .tasks import task_for
 from .._runtime import jit as runtime_jit
 
@@ -84,10 +85,11 @@ def _track_chunks(method, task, arm, targets, theta0, settings, d_max):
 
 def track(arm, targets, theta0=None, method="dls", damping=DEFAULT_DAMPING, rcond=DEFAULT_RCOND,
           clamp=None, max_step=None, gamma_max=GAMMA_MAX, joint_limits=None, limit_mode=None,
-          levels=None, rest_pose=None, rest_gain=DEFAULT_REST_GAIN):
+          levels=None, rest_pose=None, rest_gain=None):
     """Follow targets[0], targets[1], ... with one step of `method` each (Buss's protocol).
 
-    targets  (T, *target shape): one target (or one per end effector) per time step.
+    targets  (T, *target shape): one target (or one per end effector) per time step, T >= 1
+             (an empty path raises a ValueError). Numbers are checked as in ik.solve.
     clamp    D_max: each end effector's error is clamped to at most D_max before the step.
     max_step cap on any joint's change per step (radians).
     joint_limits, limit_mode, levels, rest_pose, rest_gain: as in ik.solve.
@@ -96,7 +98,12 @@ def track(arm, targets, theta0=None, method="dls", damping=DEFAULT_DAMPING, rcon
     targets = as_array(targets, "targets")
     if targets.ndim < 2:
         raise ValueError(f"targets: expected one target per time step, got shape {targets.shape}")
+    if targets.shape[0] == 0:
+        raise ValueError(f"targets: expected at least one time step, got none (shape {targets.shape})")
     task = task_for(arm, targets.shape[1:], "targets")
+    if hasattr(task, "check_target"):  # pose targets: rigid transforms only
+        task.check_target(targets, "targets")
+    check_method_target(method, task, arm, "targets")
     theta0 = np.zeros(arm.n_joints) if theta0 is None else as_array(theta0, "theta0", shape=(arm.n_joints,))
     settings = Settings(
         tol=0.0, damping=as_number(damping, "damping", minimum=0),
@@ -107,6 +114,7 @@ def track(arm, targets, theta0=None, method="dls", damping=DEFAULT_DAMPING, rcon
     method, settings, theta0 = with_extras(method, task, arm, first, jnp.asarray(theta0),
                                            settings, levels, rest_pose, rest_gain, joint_limits,
                                            limit_mode, batch=True)
+    require_traceable(method, task, arm, first[0], theta0, settings)  # track compiles the step
     d_max = np.inf if clamp is None else as_number(clamp, "clamp", minimum=0, strict=True)
     thetas, errors = _track_chunks(method, task, arm, np.asarray(targets), theta0, settings,
                                    jnp.asarray(d_max))

@@ -47,12 +47,10 @@ jax.tree_util.register_dataclass(
 
 def _indices(values, name, count, upper):
     """values as a tuple of ints, each in [-1, upper(i)) ; upper(i) is a function of the position i."""
-    try:
-        out = tuple(int(v) for v in values)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}: expected a list of integer joint indices, got {values!r:.80}") from None
-    if any(int(v) != v for v in np.asarray(values, dtype=float)):
-        raise ValueError(f"{name}: expected integer joint indices, got {values!r:.80}")
+    if isinstance(values, (str, bytes)) or not np.iterable(values) or any(
+            isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) for v in values):
+        raise ValueError(f"{name}: expected a list of integer joint indices, got {values!r:.80}")
+    out = tuple(int(v) for v in values)
     if len(out) != count:
         raise ValueError(f"{name}: expected {count} entries, got {len(out)}")
     for i, v in enumerate(out):
