@@ -14,7 +14,7 @@ export UV_PYTHON_DOWNLOADS := never
 # may not write them itself, e.g. PYTHONDONTWRITEBYTECODE, a read-only venv).
 SYNC := $(UV) sync --locked --inexact --extra dev --compile-bytecode
 
-.PHONY: lab test test-latest lock lock-upgrade header notebooks strip bench clean exercises test-browser
+.PHONY: lab test test-latest test-lowest lock lock-upgrade header notebooks strip bench clean exercises test-browser
 
 # uv itself comes from PyPI, into the venv (the lock then keeps it at its locked version).
 $(UV):
@@ -55,6 +55,20 @@ test-latest: $(STAMP)
 	$(UV) pip install --quiet --compile-bytecode --python $(LATEST_VENV)/bin/python --upgrade -e ".[dev]"
 	$(LATEST_VENV)/bin/python -m pytest $(PYTEST_ARGS)
 
+# The same suite against the LOWEST versions pyproject.toml allows for its direct dependencies
+# (uv's --resolution lowest-direct; the rest resolve to their newest), in its own venv: the
+# check that the lower bounds are true. The resolved versions are kept in
+# $(LOWEST_VENV)/requirements.txt; the venv is synced to exactly those (nothing else kept).
+LOWEST_VENV ?= .venv-lowest
+test-lowest: $(STAMP)
+	@test -x $(LOWEST_VENV)/bin/python || $(UV) venv --quiet --python $(PY) $(LOWEST_VENV)
+	$(UV) pip compile --quiet --resolution lowest-direct --extra dev --no-header \
+		--python $(LOWEST_VENV)/bin/python -o $(LOWEST_VENV)/requirements.txt pyproject.toml
+	$(UV) pip sync --quiet --compile-bytecode --python $(LOWEST_VENV)/bin/python \
+		$(LOWEST_VENV)/requirements.txt
+	$(UV) pip install --quiet --no-deps --python $(LOWEST_VENV)/bin/python -e .
+	$(LOWEST_VENV)/bin/python -m pytest $(PYTEST_ARGS)
+
 # After editing dependencies in pyproject.toml: record them in uv.lock (other pins unchanged).
 # Once a semester (before it starts): `make lock-upgrade` moves every pin to the newest allowed.
 # Both rewrite binder/constraints.txt, Binder's copy of the lock.
@@ -92,7 +106,7 @@ exercises: $(STAMP)
 	$(PY) -m ikteach.course.exercises build
 
 clean:
-	rm -rf $(VENV) $(LATEST_VENV) .pytest_cache .hypothesis
+	rm -rf $(VENV) $(LATEST_VENV) $(LOWEST_VENV) .pytest_cache .hypothesis
 
 # Benchmarks print tables (never part of make test). The peer libraries of the bench extra
 # go into their own venv, so that they never change what the tests run against.

@@ -11,7 +11,7 @@ except ModuleNotFoundError:  # Python 3.10
 from ikteach.course import course_home
 
 ROOT = Path(__file__).resolve().parents[1]
-RUNTIME = {"jax", "numpy", "matplotlib", "pyvista", "scikit-image", "ipywidgets"}
+RUNTIME = {"jax", "jaxlib", "numpy", "matplotlib", "pyvista", "scikit-image", "ipywidgets"}
 
 
 def _name(requirement):

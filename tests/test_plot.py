@@ -124,7 +124,9 @@ def test_an_animation_renders_each_saved_frame_once(monkeypatch):
     monkeypatch.setattr(matplotlib.figure.Figure, "draw",
                         lambda fig, renderer: renders.append(1) or original(fig, renderer))
     html = anim.to_jshtml()
-    assert len(renders) == html.count("data:image/png") == len(anim.iterations)
+    # matplotlib < 3.11 itself draws each saved frame twice (make test-lowest); ours adds none
+    per_frame = 1 if tuple(int(v) for v in matplotlib.__version__.split(".")[:2]) >= (3, 11) else 2
+    assert len(renders) == per_frame * html.count("data:image/png") == per_frame * len(anim.iterations)
 
 
 def _png_pixels(png):

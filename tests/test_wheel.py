@@ -2,11 +2,12 @@
 (plus a probe data file, to show that new package data is shipped), the wheel installed into
 a clean venv in a temporary folder, then a solve, a plot and an off-screen pyvista scene run
 from there. A second venv stands in for Colab: Colab's preinstalled jax, numpy, matplotlib
-and ipywidgets first, then the wheel, which must leave them as they are.
+and ipywidgets first, then the wheel, which upgrades those below pyproject's bounds only.
 
 uv does the builds and installs (from its cache after the first run; pins from the lock).
 """
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -26,6 +27,11 @@ PROBE = "data/_probe_for_tests.txt"
 COLAB_PYTHON = "3.12"
 COLAB = {"jax": "0.5.2", "jaxlib": "0.5.1", "numpy": "2.0.2", "matplotlib": "3.10.0",
          "ipywidgets": "7.7.1"}
+# Colab's jax, jaxlib and ipywidgets are below pyproject's lower bounds (jax 0.10.2: other
+# printed numbers; ipywidgets 8: the demo's static still), so the wheel upgrades them;
+# matplotlib stays, and numpy too unless the newest jax for that Python needs a newer one
+# (jax 0.12, Python >= 3.12: numpy >= 2.2).
+COLAB_UPGRADED = ("jax", "jaxlib", "ipywidgets")
 
 SMOKE = r'''
 import importlib.resources, sys
@@ -133,8 +139,8 @@ def test_wheel_and_sdist_ship_the_module_and_package_data(dist):
     assert "Project-URL: Repository, https://github.com/" in metadata
     requires = [line for line in metadata.splitlines() if line.startswith("Requires-Dist:")]
     runtime = [r for r in requires if "extra ==" not in r]
-    assert {r.split()[1].split(">")[0].split("[")[0] for r in runtime} == {
-        "jax", "numpy", "matplotlib", "pyvista", "scikit-image", "ipywidgets"}
+    assert {re.split(r"[<>=!\[ ]", r.split()[1])[0] for r in runtime} == {
+        "jax", "jaxlib", "numpy", "matplotlib", "pyvista", "scikit-image", "ipywidgets"}
 
 
 def test_wheel_in_a_clean_venv_solves_plots_and_renders(dist, tmp_path):
@@ -163,23 +169,25 @@ def _colab_python():
     return candidates[-1] if candidates else sys.executable
 
 
-def test_wheel_on_a_colab_like_kernel_keeps_colabs_versions(dist, tmp_path):
+def test_wheel_on_a_colab_like_kernel_keeps_colabs_numpy_and_matplotlib(dist, tmp_path):
     wheel, _ = dist
     python = _venv(tmp_path, _colab_python())
     _uv("pip", "install", "--quiet", "--python", str(python),
         *[f"{name}=={version}" for name, version in COLAB.items()])
     _uv("pip", "install", "--quiet", "--python", str(python), str(wheel))  # what Colab's cell does
-    listed = _uv("pip", "list", "--python", str(python)).stdout
-    for name, version in COLAB.items():
-        assert any(line.split()[:2] == [name, version] for line in listed.splitlines()), \
-            f"installing the wheel changed Colab's {name} {version}"
+    listed = dict(line.split()[:2] for line in
+                  _uv("pip", "list", "--python", str(python)).stdout.splitlines()[2:])
+    for name in COLAB_UPGRADED:
+        assert listed[name] != COLAB[name], f"Colab's {name} {COLAB[name]} was kept"
+    assert listed["matplotlib"] == COLAB["matplotlib"], "installing the wheel changed matplotlib"
+    jax_version = tuple(int(v) for v in listed["jax"].split(".")[:2])
+    assert listed["numpy"] == COLAB["numpy"] or jax_version >= (0, 12), listed["numpy"]
     work = tmp_path / "work"
     work.mkdir()
     (work / "smoke.py").write_text(SMOKE)
     out = _run(python, "smoke.py", str(ROOT), "--demo", cwd=work).stdout
-    assert "solve: converged" in out and "split = whole" in out and "demo: 7.7.1" in out
-    # Colab's jaxlib 0.5 loads our loops from its cache wrongly ("running" after 0 iterations):
-    # the cache stays off there, and a second run (which would load from it) still solves
-    assert "cache: None" in out
+    assert "solve: converged" in out and "split = whole" in out
+    assert f"demo: {listed['ipywidgets']}" in out
+    # a second run loads the loops from the compilation cache and still solves
     again = _run(python, "smoke.py", str(ROOT), cwd=work).stdout
     assert "solve: converged" in again and "split = whole" in again

@@ -1,4 +1,5 @@
 """Workspace maps: grids, boundaries against the analytic reach, tracking, image regression."""
+import matplotlib
 import numpy as np
 import pytest
 
@@ -8,7 +9,8 @@ from ikteach.pictures import workspace_maps as ws
 from render_reference import MAP_ARM, MAP_PNG, map_image, read_png, ssim
 
 # Same render: 1.0; middle link 0.5 -> 0.55: 0.89; colour map viridis -> magma: 0.76.
-MAP_SSIM = 0.98
+# matplotlib before 3.11 (make test-lowest) resamples the image a little differently: 0.946.
+MAP_SSIM = 0.98 if tuple(int(v) for v in matplotlib.__version__.split(".")[:2]) >= (3, 11) else 0.92
 
 
 def test_map_matches_the_reference_image():
