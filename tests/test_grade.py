@@ -249,9 +249,9 @@ def test_odd_names_and_lone_surrogates_are_graded(graded):
     rows = graded.rows
     assert scores(rows["student-\\xff-name"])[1] == 10.0
     assert scores(rows["odd_file_name"])[1] == 10.0
-    assert "02_jt_step-\\xfe.ipynb (" in graded.feedback["odd_file_name"]
+    assert "(02_jt_step-\\xfe.ipynb): 10/10" in graded.feedback["odd_file_name"]
     assert scores(rows["surrogate"])[0][5] == 10.0
-    assert "| ? Stretched towards" in graded.feedback["surrogate"]
+    assert "| ? ### BEGIN SOLUTION" in graded.feedback["surrogate"]  # the surrogate: "?"
 
 
 def test_time_limits_hold_from_outside(graded):
@@ -312,3 +312,44 @@ def test_exercise_number_from_metadata_or_name():
 def test_missing_submissions_dir_is_a_clear_error(tmp_path):
     with pytest.raises(ValueError, match="SUBMISSIONS_DIR"):
         grade.grade_all(tmp_path / "nope", tmp_path / "g.csv")
+
+
+def one_student(tmp_path):
+    subs = tmp_path / "subs"
+    (subs / "alice").mkdir(parents=True)
+    shutil.copy(ROOT / "instructor" / "solutions" / "02_jt_step.ipynb", subs / "alice")
+    return subs, tmp_path / "out" / "grades.csv"
+
+
+@pytest.mark.parametrize("breakage", ["reference not blocked", "runner missing"])
+def test_a_failing_self_check_stops_before_grading_anyone(tmp_path, monkeypatch, capsys,
+                                                          breakage):
+    """The grader cannot grade here: exit status 3, why, and no CSV of wrong zeros."""
+    from ikteach.course.check import ex02_jt_step
+    if breakage == "reference not blocked":
+        monkeypatch.setattr(ex02_jt_step, "REFERENCES", ())
+        why = "a wrapper of ik.jt_step (exercise 2) got 10/10 (expected 0/10"
+    else:
+        monkeypatch.setattr(grade, "RUNNER", tmp_path / "no-such-runner.py")
+        why = "a correct jt_step (exercise 2) got 10/10 (expected 10/10, without notes)"
+    subs, out = one_student(tmp_path)
+    flags = [] if SANDBOXED else ["--no-sandbox"]
+    assert grade.main([str(subs), "--out", str(out), "--grade-timeout", "60"] + flags) == 3
+    err = capsys.readouterr().err
+    assert "grade: stopped: the grader's self-check failed" in err and why in err, err
+    assert not out.exists()
+
+
+def test_packages_the_sandbox_does_not_show_stop_the_grader(tmp_path, monkeypatch, capsys):
+    """The grader's packages hidden in the sandbox (as a venv it cannot see): exit status 2
+    before anyone is graded. Without a sandbox: the refusal, also exit status 2."""
+    import numpy
+    monkeypatch.setattr(grade, "INSTRUCTOR", Path(numpy.__file__).resolve().parents[1])
+    subs, out = one_student(tmp_path)
+    assert grade.main([str(subs), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    if SANDBOXED:
+        assert "packages do not work in the sandbox: ModuleNotFoundError" in err, err
+    else:
+        assert "no sandbox for the students' code" in err, err
+    assert not out.exists()
