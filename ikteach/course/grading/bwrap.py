@@ -25,6 +25,10 @@ NAMESPACES = ["--unshare-user", "--uid", SANDBOX_ID, "--gid", SANDBOX_ID, "--cap
 VARIANTS = (["--disable-userns"], [])  # tried in this order
 
 
+class SandboxUnavailable(RuntimeError):
+    """No backend isolates student code here; the message says what was tried and what to do."""
+
+
 _is_dir = os.path.isdir
 
 
@@ -103,8 +107,6 @@ def working_flags(bwrap):
 def judge(seen, escaped, hidden):
     """The lines the log may state, from what the probe saw; raises SandboxUnavailable (with
     every property that does not hold) when the sandbox does not isolate."""
-    from .sandbox import SandboxUnavailable
-
     failures = []
     if seen.get("uid") in (0, None):
         failures.append(f"the student's process runs as uid {seen.get('uid')}")

@@ -26,6 +26,9 @@ import time
 from pathlib import Path
 
 from . import bwrap as _bwrap
+from .bwrap import SandboxUnavailable
+
+__all__ = ["Limits", "Process", "Sandbox", "SandboxUnavailable", "refusal"]
 
 LAUNCH = Path(__file__).with_name("_launch.py")
 PROBE = Path(__file__).with_name("probe.py")
@@ -39,10 +42,6 @@ INSTALL_HINT = ("install bubblewrap (Debian/Ubuntu: sudo apt-get install bubblew
                 "sudo dnf install bubblewrap; Arch: sudo pacman -S bubblewrap); on macOS or "
                 "Windows grade inside a Linux VM or container that has it (README, Grading)")
 OVERRIDE = "--no-sandbox"
-
-
-class SandboxUnavailable(RuntimeError):
-    """No backend isolates student code here; the message says what was tried and what to do."""
 
 
 @dataclasses.dataclass(frozen=True)
