@@ -75,7 +75,7 @@ def test_a_solution_scores_full_marks(bundle, tmp_path):
     [test] = data["tests"]
     assert (test["name"], test["score"], test["max_score"]) == (
         "Exercise 2 (02_jt_step.ipynb)", 10.0, 10.0)
-    assert "passed, 10/10" in test["output"] and "sandbox: enforced:" in data["output"]
+    assert "passed, 10/10" in test["output"] and "sandbox: bubblewrap; enforced:" in data["output"]
 
 
 def test_a_wrong_submission_gets_its_marks_and_feedback(bundle, tmp_path):
