@@ -169,8 +169,9 @@ class Sandbox:
                       "writable): a fork storm is bounded only by the CPU and time limits")
         if self.bwrap:
             yes += [f"{line} (checked at start-up)" for line in self.verified]
-            yes.append("visible, read-only: the system libraries, the grader's Python and "
-                       "ikteach's package (without its checker); nothing else of this machine")
+            yes.append("visible, read-only, by its mount list (probed only as above): the "
+                       "system libraries, the grader's Python, ikteach's package without its "
+                       "checker; nothing else of this machine")
             no.append("a kernel exploit (bubblewrap shares this machine's kernel)")
         else:
             no += [f"ISOLATION: NONE ({OVERRIDE}): students' code runs with this user's rights",
