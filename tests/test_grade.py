@@ -1,9 +1,19 @@
 """python -m ikteach.course.grade on the solutions, the untouched templates, the wrong and the hostile
-submissions (tests/submissions/, written by make_hostile.py).
+submissions (tests/submissions/, written by make_hostile.py) and on a submissions folder that
+is itself hostile (links, a FIFO, a directory named like a notebook, deep JSON, odd names).
 
-One grading run (two notebooks at a time) serves every test here.
+One grading run (two notebooks at a time) serves every test here. Where this machine has a
+sandbox (bubblewrap) the run is the normal one. Where it has none, the grader must refuse
+(checked first: exit status 2, what to install, the override flag, no CSV); the run is then
+made with --no-sandbox, without the submissions that only a sandbox stops (they would really
+write outside, or read the checker), and every test of isolation checks the refusal instead.
 """
+import collections
 import csv
+import json
+import os
+import platform
+import re
 import shutil
 import subprocess
 import sys
@@ -13,13 +23,66 @@ from pathlib import Path
 import pytest
 
 from ikteach.course import grade
+from ikteach.course.grading.sandbox import Sandbox, SandboxUnavailable
 
 ROOT = Path(__file__).resolve().parents[1]
 WRONG = ROOT / "tests" / "submissions"
-STUDENTS = sorted(p.name for p in WRONG.iterdir() if p.is_dir())
 UNTOUCHED = ["01_jacobian.ipynb", "06_singularity_study.ipynb", "07_priority_step.ipynb"]
+PLANTED = [ROOT / "ikteach" / "course" / "planted_by_student.py", ROOT / "planted_by_student.py"]
 ESCAPES = [Path("/tmp/ikteach-escaped.txt"), Path("/var/tmp/ikteach-escaped.txt"),
-           ROOT / "ESCAPED.txt"]
+           ROOT / "ESCAPED.txt"] + PLANTED
+# only a sandbox stops these: without one they are left out (and the refusal is checked)
+NEEDS_SANDBOX = {"write_outside", "steal_solution", "fork_storm", "hostile", "remount_plant",
+                 "ref_checker_reimport"}
+TIMEOUT, GRADE_TIMEOUT = 10, 60
+ODD_STUDENT = b"student-\xff-name"          # a folder name that is not UTF-8
+ODD_FILE = b"02_jt_step-\xfe.ipynb"          # a notebook name that is not UTF-8
+
+
+def _have_sandbox():
+    try:
+        Sandbox().close()
+        return True
+    except SandboxUnavailable:
+        return False
+
+
+SANDBOXED = _have_sandbox()
+STUDENTS = sorted(p.name for p in WRONG.iterdir() if p.is_dir()
+                  and (SANDBOXED or p.name not in NEEDS_SANDBOX))
+Graded = collections.namedtuple("Graded", "rows feedback before log stderr refusal")
+
+
+def hostile_folder(subs):
+    """Students whose folder, not their code, attacks the grader (issue 24, class 2)."""
+    solutions = ROOT / "instructor" / "solutions"
+    (subs / "symlink_file").mkdir()
+    (subs / "symlink_file" / "04_dls_step.ipynb").symlink_to(solutions / "04_dls_step.ipynb")
+    (subs / "symlink_folder").symlink_to(solutions, target_is_directory=True)
+    (subs / "device").mkdir()
+    (subs / "device" / "05_stop_rule.ipynb").symlink_to("/dev/zero")
+    (subs / "dir_named" / "01_jacobian.ipynb").mkdir(parents=True)
+    shutil.copy(solutions / "01_jacobian.ipynb", subs / "dir_named" / "01_jacobian.ipynb" / "x.ipynb")
+    (subs / "fifo").mkdir()
+    os.mkfifo(subs / "fifo" / "02_jt_step.ipynb")
+    (subs / "deep_json").mkdir()
+    (subs / "deep_json" / "03_pinv_step.ipynb").write_text("[" * 100_000 + "]" * 100_000)
+    (subs / "deep_dict").mkdir()
+    nested = {}
+    for _ in range(100):
+        nested = {"x": nested}
+    (subs / "deep_dict" / "03_pinv_step.ipynb").write_text(json.dumps({"cells": [], "metadata": nested}))
+    odd = os.path.join(os.fsencode(subs), ODD_STUDENT)
+    os.mkdir(odd)
+    shutil.copy(solutions / "02_jt_step.ipynb", os.path.join(odd, b"02_jt_step.ipynb"))
+    (subs / "odd_file_name").mkdir()
+    shutil.copy(solutions / "02_jt_step.ipynb", os.path.join(os.fsencode(subs / "odd_file_name"), ODD_FILE))
+    (subs / "surrogate").mkdir()  # lone surrogates in the written answer and in a comment
+    book = json.loads((solutions / "06_singularity_study.ipynb").read_text())
+    for cell in book["cells"]:
+        cell["source"] = ("# \ud800 comment\n" if cell["cell_type"] == "code" else "\udfff ") + \
+            "".join(cell["source"])
+    (subs / "surrogate" / "06_singularity_study.ipynb").write_text(json.dumps(book))
 
 
 @pytest.fixture(scope="module")
@@ -33,31 +96,57 @@ def graded(tmp_path_factory):
     for student in STUDENTS:
         shutil.copytree(WRONG / student, subs / student)
     (subs / "untouched" / "notes.txt").write_text("not a notebook: ignored")
-    before = {p: p.read_bytes() for p in subs.rglob("*") if p.is_file()}
+    hostile_folder(subs)
+    before = {p: p.read_bytes() for p in subs.rglob("*") if p.is_file() and not p.is_symlink()
+              and not p.is_fifo()}
     for path in ESCAPES:
         path.unlink(missing_ok=True)
     out = base / "out" / "grades.csv"
-    run = subprocess.run([sys.executable, "-m", "ikteach.course.grade", str(subs), "--out", str(out),
-                          "--timeout", "10", "--jobs", "2"],
-                         capture_output=True, text=True, timeout=1500, cwd=base)
+    command = [sys.executable, "-m", "ikteach.course.grade", str(subs), "--out", str(out),
+               "--timeout", str(TIMEOUT), "--grade-timeout", str(GRADE_TIMEOUT), "--jobs", "2"]
+    # another OpenBLAS kernel in the grader than the default one (any x86-64 runs Prescott's):
+    # the student's process must compute with the same, or no_cutoff's diagnosis changes
+    env = dict(os.environ)
+    if platform.machine() in ("x86_64", "AMD64"):
+        env.setdefault("OPENBLAS_CORETYPE", "Prescott")
+    refusal = None
+    if not SANDBOXED:  # first as a lecturer would: the grader must refuse
+        refusal = subprocess.run(command, capture_output=True, text=True, timeout=300, cwd=base,
+                                 env=env)
+        refusal = (refusal.returncode, refusal.stderr, out.exists())
+        command.append("--no-sandbox")
+    run = subprocess.run(command, capture_output=True, text=True, timeout=1500, cwd=base, env=env)
     assert run.returncode == 0, run.stderr[-3000:]
-    rows = {r["student"]: r for r in csv.DictReader(out.open())}
-    feedback = {p.stem: p.read_text() for p in (base / "out" / "feedback").glob("*.txt")}
-    return rows, feedback, before, run.stdout
+    rows = {r["student"]: r for r in csv.DictReader(out.open(encoding="utf-8"))}
+    feedback = {p.stem: p.read_text(encoding="utf-8")
+                for p in (base / "out" / "feedback").glob("*.txt")}
+    return Graded(rows, feedback, before, run.stdout, run.stderr, refusal)
 
 
 def scores(row):
     return [float(row[f"ex{n}"]) for n in range(1, 8)], float(row["total"])
 
 
+def refused(graded):
+    """Without a sandbox: the plain run was refused as it should be (True). With one: False."""
+    if SANDBOXED:
+        return False
+    status, stderr, wrote_csv = graded.refusal
+    assert status == 2 and not wrote_csv, stderr
+    assert "no sandbox for the students' code" in stderr and "bwrap" in stderr
+    assert "apt-get install bubblewrap" in stderr and "--no-sandbox" in stderr
+    return True
+
+
 def test_one_row_and_one_feedback_file_per_student(graded):
-    rows, feedback, *_ = graded
-    students = {"solutions", "untouched"} | set(STUDENTS)
-    assert set(rows) == students and set(feedback) == students
+    students = {"solutions", "untouched", "symlink_file", "symlink_folder", "device", "dir_named",
+                "fifo", "deep_json", "deep_dict", "odd_file_name", "surrogate",
+                "student-\\xff-name"} | set(STUDENTS)
+    assert set(graded.rows) == students and set(graded.feedback) == students
 
 
 def test_solutions_get_full_marks(graded):
-    rows, feedback, *_ = graded
+    rows, feedback = graded.rows, graded.feedback
     assert scores(rows["solutions"]) == ([10.0] * 7, 70.0)
     assert feedback["solutions"].count("passed, 10/10") == 7
     # exercise 6's written answer is copied for the instructor, not marked
@@ -66,7 +155,7 @@ def test_solutions_get_full_marks(graded):
 
 
 def test_untouched_templates_get_zero(graded):
-    rows, feedback, *_ = graded
+    rows, feedback = graded.rows, graded.feedback
     assert scores(rows["untouched"]) == ([0.0] * 7, 0.0)
     assert feedback["untouched"].count("not yet implemented") == len(UNTOUCHED)
     assert "your written answer" not in feedback["untouched"]  # the placeholder is skipped
@@ -82,10 +171,10 @@ def test_untouched_templates_get_zero(graded):
 ])
 def test_wrong_submissions_get_partial_marks_and_the_right_feedback(graded, student, exercise,
                                                                      score, line):
-    rows, feedback, *_ = graded
-    marks, total = scores(rows[student])
+    marks, total = scores(graded.rows[student])
     assert marks[exercise - 1] == score and total == score
-    assert f"Exercise {exercise} (" in feedback[student] and line in feedback[student]
+    assert f"Exercise {exercise} (" in graded.feedback[student]
+    assert line in graded.feedback[student]
 
 
 # hostile submissions: (student, exercise, marks, a line of its feedback)
@@ -94,8 +183,9 @@ HOSTILE = [
     ("forge_check", 3, 0, "not yet implemented"),
     # prints fake grade lines, replaces print, sys.stdout and the display hook: template
     ("forge_output", 2, 0, "not yet implemented"),
-    # patches the checks from inside its own function (which runs in another process)
-    ("patch_in_function", 2, 7, "alpha looks fixed: it is 0.1 in every case"),
+    # patches the checks from inside its own function: the checker is not there to import
+    ("patch_in_function", 2, 0, "raised ModuleNotFoundError: ikteach.course.check is not "
+                                "available while grading"),
     # writes outside its folder (the files are checked below); its function is right
     ("write_outside", 1, 10, "passed, 10/10"),
     ("fork_storm", 2, 10, "passed, 10/10"),
@@ -105,23 +195,92 @@ HOSTILE = [
     ("hostile", 3, 10, "did not finish within the notebook's time limit (10 s)"),
     ("not_json", 1, 0, "it is not JSON"),
     ("no_functions", 3, 0, "`pinv_step` not found in the notebook"),
+    # as root too: detach the checker's cover, remount / and the package, new user namespace,
+    # plant modules where the grader imports from (checked below); its function is right
+    ("remount_plant", 2, 10, "passed, 10/10"),
 ]
 
 
 @pytest.mark.parametrize("student, exercise, score, line", HOSTILE)
 def test_a_hostile_submission_loses_only_its_own_marks(graded, student, exercise, score, line):
-    rows, feedback, *_ = graded
-    marks, total = scores(rows[student])
-    assert marks[exercise - 1] == score and total == score, feedback[student]
-    assert line in feedback[student], feedback[student]
+    if student in NEEDS_SANDBOX and refused(graded):
+        return
+    marks, total = scores(graded.rows[student])
+    assert marks[exercise - 1] == score and total == score, graded.feedback[student]
+    assert line in graded.feedback[student], graded.feedback[student]
+
+
+# issue 24, class 1: ikteach's own answer under the exercise's name scores nothing
+OWN_CODE = [
+    ("ref_plain", 2, "`jt_step` raised ReferenceBlocked: ikteach's jt_step is the reference"),
+    ("ref_import", 2, "`jt_step` is not a function written in your notebook: it is "
+                      "ikteach.core.jt"),
+    ("ref_decorator", 3, "`pinv_step` is not a function written in your notebook"),
+    ("ref_default", 4, "raised ReferenceBlocked: ikteach's dls_step is the reference"),
+    ("ref_class", 1, "raised ReferenceBlocked: ikteach's jacobian is the reference"),
+    ("ref_annotation", 7, "`priority_step` is not a function written in your notebook"),
+    ("ref_checker", 6, "`study` raised AttributeError"),
+    ("ref_checker_reimport", 6, "`study` raised ModuleNotFoundError"),
+]
+
+
+@pytest.mark.parametrize("student, exercise, line", OWN_CODE)
+def test_marks_only_for_the_students_own_code(graded, student, exercise, line):
+    if student in NEEDS_SANDBOX and refused(graded):
+        return
+    marks, total = scores(graded.rows[student])
+    assert marks[exercise - 1] == 0 and total == 0, graded.feedback[student]
+    assert line in graded.feedback[student], graded.feedback[student]
+
+
+# issue 24, class 2: (student, the reason in the CSV's notes and the feedback)
+FOLDER = [
+    ("symlink_file", "04_dls_step.ipynb: not read: it is a symbolic link"),
+    ("symlink_folder", "the student's folder is a symbolic link: not read"),
+    ("device", "05_stop_rule.ipynb: not read: it is a symbolic link"),
+    ("dir_named", "01_jacobian.ipynb: not read: it is a directory"),
+    ("fifo", "02_jt_step.ipynb: not read: it is a FIFO"),
+    ("deep_json", "03_pinv_step.ipynb: could not read the notebook: its JSON is nested too deep"),
+    ("deep_dict", "03_pinv_step.ipynb: could not read the notebook: its JSON is nested over 64"),
+]
+
+
+@pytest.mark.parametrize("student, reason", FOLDER)
+def test_a_bad_file_costs_only_its_students_marks_with_a_reason(graded, student, reason):
+    assert scores(graded.rows[student]) == ([0.0] * 7, 0.0)
+    assert reason in graded.rows[student]["notes"] and reason.split(": ", 1)[1] in \
+        graded.feedback[student], graded.rows[student]
+
+
+def test_odd_names_and_lone_surrogates_are_graded(graded):
+    rows = graded.rows
+    assert scores(rows["student-\\xff-name"])[1] == 10.0
+    assert scores(rows["odd_file_name"])[1] == 10.0
+    assert "(02_jt_step-\\xfe.ipynb): 10/10" in graded.feedback["odd_file_name"]
+    assert scores(rows["surrogate"])[0][5] == 10.0
+    assert "| ? ### BEGIN SOLUTION" in graded.feedback["surrogate"]  # the surrogate: "?"
+
+
+def test_time_limits_hold_from_outside(graded):
+    """Signals ignored, then a sleep in a statement the checks' worker runs: killed at
+    --grade-timeout (the cells at --timeout), whatever the notebook does with its signals."""
+    marks, total = scores(graded.rows["sigalrm_sleep"])
+    assert total == 0
+    text = graded.feedback["sigalrm_sleep"]
+    assert f"ran past the grading time limit of {GRADE_TIMEOUT} s" in text, text
+    assert f"did not finish within the notebook's time limit ({TIMEOUT} s)" in text, text
+    took = re.search(r"sigalrm_sleep/02_jt_step.ipynb: .* \((\d+) s\)", graded.log)
+    assert int(took.group(1)) <= TIMEOUT + grade.GRACE + GRADE_TIMEOUT + 20, graded.log
 
 
 def test_nothing_escapes(graded):
-    """No file written outside the working folder, submissions untouched, no process left."""
-    _, _, before, _ = graded
+    """No file written outside the working folder, nothing planted where the grader imports
+    from, submissions untouched, no process left."""
+    if refused(graded):
+        return
     for path in ESCAPES:
         assert not path.exists(), path
-    for path, content in before.items():
+    for path, content in graded.before.items():
         assert path.read_bytes() == content
     time.sleep(1)
     left = subprocess.run(["pgrep", "-f", "sleep 77.125"], capture_output=True, text=True)
@@ -129,20 +288,26 @@ def test_nothing_escapes(graded):
 
 
 def test_the_solutions_and_other_students_are_out_of_reach(graded):
-    """The stealing submission copies a solution when it can read one: with bubblewrap it
-    cannot (0 marks); without, the log must say this is not enforced."""
-    rows, feedback, _, log = graded
-    stolen = scores(rows["steal_solution"])[1]
-    if "no writes outside the working folder (bubblewrap" in log:
-        assert stolen == 0 and "`dls_step` raised FileNotFoundError" in feedback["steal_solution"]
+    """The stealing submission copies a solution when it can read one: in the sandbox it
+    cannot (0 marks)."""
+    if refused(graded):
+        return
+    assert scores(graded.rows["steal_solution"])[1] == 0
+    assert "`dls_step` raised FileNotFoundError" in graded.feedback["steal_solution"]
+
+
+def test_the_log_and_the_csv_say_what_the_sandbox_enforces(graded):
+    log = graded.log
+    assert "sandbox: NOT enforced:" in log and "RLIMIT_CPU" in log and "RLIMIT_AS" in log
+    assert "self-check: a known-good answer got 10/10" in log
+    backends = {row["sandbox"] for row in graded.rows.values()}
+    if SANDBOXED:
+        assert "sandbox: bubblewrap; enforced:" in log and backends == {"bubblewrap"}
+        assert "with no capabilities, in its own user namespace (checked at start-up)" in log
+        assert "no network (own network namespace" in log and "WARNING" not in graded.stderr
     else:
-        assert "reading the solutions and other students' folders" in log
-
-
-def test_the_log_says_what_the_sandbox_enforces(graded):
-    log = graded[3]
-    assert "sandbox: enforced:" in log and "sandbox: NOT enforced:" in log
-    assert "RLIMIT_CPU" in log and "RLIMIT_AS" in log and "RLIMIT_FSIZE" in log
+        assert backends == {"none (--no-sandbox)"} and "ISOLATION: NONE" in log
+        assert "WARNING: --no-sandbox" in graded.stderr
 
 
 def test_exercise_number_from_metadata_or_name():
@@ -154,3 +319,44 @@ def test_exercise_number_from_metadata_or_name():
 def test_missing_submissions_dir_is_a_clear_error(tmp_path):
     with pytest.raises(ValueError, match="SUBMISSIONS_DIR"):
         grade.grade_all(tmp_path / "nope", tmp_path / "g.csv")
+
+
+def one_student(tmp_path):
+    subs = tmp_path / "subs"
+    (subs / "alice").mkdir(parents=True)
+    shutil.copy(ROOT / "instructor" / "solutions" / "02_jt_step.ipynb", subs / "alice")
+    return subs, tmp_path / "out" / "grades.csv"
+
+
+@pytest.mark.parametrize("breakage", ["reference not blocked", "runner missing"])
+def test_a_failing_self_check_stops_before_grading_anyone(tmp_path, monkeypatch, capsys,
+                                                          breakage):
+    """The grader cannot grade here: exit status 3, why, and no CSV of wrong zeros."""
+    from ikteach.course.check import ex02_jt_step
+    if breakage == "reference not blocked":
+        monkeypatch.setattr(ex02_jt_step, "REFERENCES", ())
+        why = "a wrapper of ik.jt_step (exercise 2) got 10/10 (expected 0/10"
+    else:
+        monkeypatch.setattr(grade, "RUNNER", tmp_path / "no-such-runner.py")
+        why = "a correct jt_step (exercise 2) got 10/10 (expected 10/10, without notes)"
+    subs, out = one_student(tmp_path)
+    flags = [] if SANDBOXED else ["--no-sandbox"]
+    assert grade.main([str(subs), "--out", str(out), "--grade-timeout", "60"] + flags) == 3
+    err = capsys.readouterr().err
+    assert "grade: stopped: the grader's self-check failed" in err and why in err, err
+    assert not out.exists()
+
+
+def test_packages_the_sandbox_does_not_show_stop_the_grader(tmp_path, monkeypatch, capsys):
+    """The grader's packages hidden in the sandbox (as a venv it cannot see): exit status 2
+    before anyone is graded. Without a sandbox: the refusal, also exit status 2."""
+    import numpy
+    monkeypatch.setattr(grade, "INSTRUCTOR", Path(numpy.__file__).resolve().parents[1])
+    subs, out = one_student(tmp_path)
+    assert grade.main([str(subs), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    if SANDBOXED:
+        assert "packages do not work in the sandbox: ModuleNotFoundError" in err, err
+    else:
+        assert "no sandbox for the students' code" in err, err
+    assert not out.exists()

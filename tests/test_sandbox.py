@@ -1,4 +1,8 @@
-"""The sandbox one student process runs in, and the AST extraction of student code."""
+"""The sandbox one student process runs in, and the AST extraction of student code.
+
+Where this machine has a sandbox (bubblewrap) the tests attack it from inside; where it has
+none they check that it refuses, and what the override (--no-sandbox) still enforces."""
+import os
 import socket
 import subprocess
 import sys
@@ -7,8 +11,21 @@ from pathlib import Path
 
 import pytest
 
-from ikteach.course.grading import extract
-from ikteach.course.grading.sandbox import Limits, Sandbox
+from ikteach.course.grading import bwrap, extract
+from ikteach.course.grading.sandbox import Limits, Sandbox, SandboxUnavailable
+
+PACKAGE = Path(__file__).resolve().parents[1] / "ikteach"
+
+
+def _have_sandbox():
+    try:
+        Sandbox().close()
+        return True
+    except SandboxUnavailable:
+        return False
+
+
+SANDBOXED = _have_sandbox()
 
 
 def run_in(sandbox, tmp_path, code):
@@ -23,84 +40,182 @@ def run_in(sandbox, tmp_path, code):
     return process.proc.returncode, out
 
 
+def assert_refused():
+    with pytest.raises(SandboxUnavailable) as refusal:
+        Sandbox()
+    text = str(refusal.value)
+    assert "tried: bubblewrap: `bwrap` not found on PATH" in text, text
+    assert "apt-get install bubblewrap" in text and "--no-sandbox" in text
+
+
 @pytest.fixture
 def sandbox(tmp_path):
+    """(the sandbox, a hidden folder) - or None where there is none (the refusal checked)."""
     secret = tmp_path / "solutions"
     secret.mkdir()
     (secret / "answer.txt").write_text("42")
+    if not SANDBOXED:
+        assert_refused()
+        yield None
+        return
     box = Sandbox([secret], Limits(memory_mb=512, cpu_seconds=20))
+    box.verify()
     yield box, secret
     box.close()
 
 
-def test_limits_hold_in_every_mode(sandbox, tmp_path):
-    box, _ = sandbox
-    code, out = run_in(box, tmp_path, """
+def test_limits_hold_with_and_without_isolation(sandbox, tmp_path):
+    unsandboxed = Sandbox([], Limits(memory_mb=512, cpu_seconds=20), bwrap=False,
+                          unsandboxed=True)
+    for box in [unsandboxed] + ([sandbox[0]] if sandbox else []):
+        code, out = run_in(box, tmp_path, """
+            try:
+                b = bytearray(2 << 30)   # 2 GiB > 512 MiB
+                print("allocated")
+            except MemoryError:
+                print("MemoryError")
+            import os; print(os.environ["HOME"].endswith("/home"), sorted(os.environ)[:3])
+            """)
+        assert "MemoryError" in out and "True" in out, out
+    unsandboxed.close()
+
+
+ATTACK = """
+    import ctypes, os, socket
+    libc = ctypes.CDLL(None, use_errno=True)
+    for path in {writes!r}:
         try:
-            b = bytearray(2 << 30)   # 2 GiB > 512 MiB
-            print("allocated")
-        except MemoryError:
-            print("MemoryError")
-        import os; print(os.environ["HOME"].endswith("/home"), sorted(os.environ)[:3])
-        """)
-    assert "MemoryError" in out and "True" in out, out
+            open(path, "w").write("x"); print("wrote", path)
+        except OSError as exc:
+            print("no write", type(exc).__name__)
+    for folder in {reads!r}:
+        print("listing:", sorted(os.listdir(folder)) if os.path.isdir(folder) else None)
+    try:
+        socket.create_connection(("127.0.0.1", {port}), timeout=2); print("connected")
+    except OSError:
+        print("no network")
+    status = dict(l.split(":", 1) for l in open("/proc/self/status") if l.startswith("Cap"))
+    print("uid", os.getuid(), "caps", sorted({{int(v, 16) for v in status.values()}}))
+    print("umount", libc.umount2({check!r}.encode(), 2))
+    print("remount", libc.mount(None, b"/", None, 32 | 4096, None),
+          libc.mount(None, {package!r}.encode(), None, 32 | 4096, None))
+    print("unshare", libc.unshare(0x10000000))
+    print("listing after:", os.listdir({check!r}))
+    """
 
 
-def test_bubblewrap_hides_blocks_writes_and_network_or_the_report_says_not(sandbox, tmp_path):
+def test_a_student_process_cannot_escape_hide_or_regain_power(sandbox, tmp_path):
+    """Writes outside (also where the grader imports from), hidden folders, the network,
+    capabilities, mounts and new user namespaces - also when the grader runs as root."""
+    if sandbox is None:
+        return  # the refusal was checked by the fixture
     box, secret = sandbox
-    enforced, not_enforced = box.report()
-    outside = tmp_path / "escaped.txt"  # under /tmp: bubblewrap gives the run a private /tmp
-    repo = Path(__file__).resolve().parents[1] / "ESCAPED-sandbox-test.txt"  # read-only there
-    home = Path.home() / "ESCAPED-sandbox-test.txt"  # on the read-only root wherever the repo is
+    check = str(PACKAGE / "course" / "check")
+    private = tmp_path / "escaped.txt"  # the run's /tmp is its own: a write there goes nowhere
+    outside = [PACKAGE / "course" / "planted.py", PACKAGE.parent / "planted.py",
+               Path.home() / "ESCAPED-sandbox-test.txt", Path(sys.prefix) / "planted.pth"]
     server = socket.socket()
     server.bind(("127.0.0.1", 0))
     server.listen()
-    port = server.getsockname()[1]
-    code, out = run_in(box, tmp_path, f"""
-        import os, socket
-        for path in [{str(outside)!r}, {str(repo)!r}, {str(home)!r}]:
-            try:
-                open(path, "w").write("x"); print("wrote")
-            except OSError as exc:
-                print("no write", type(exc).__name__)
-        print("secret files:", os.listdir({str(secret)!r}) if os.path.isdir({str(secret)!r}) else None)
-        try:
-            socket.create_connection(("127.0.0.1", {port}), timeout=2); print("connected")
-        except OSError:
-            print("no network")
-        """)
+    code, out = run_in(box, tmp_path, ATTACK.format(
+        writes=[str(p) for p in outside + [private]], reads=[str(secret), check, str(PACKAGE.parent)],
+        port=server.getsockname()[1], check=check, package=str(PACKAGE)))
     server.close()
-    if box.bwrap:
-        assert "no write" in out and "no network" in out, out
-        assert "secret files: None" in out or "secret files: []" in out, out
-        assert not outside.exists() and not repo.exists() and not home.exists()  # nothing escaped
-        assert any("no network" in line for line in enforced)
-    else:
-        repo.unlink(missing_ok=True)
-        home.unlink(missing_ok=True)
-        assert any(line.startswith("network") for line in not_enforced)
-        assert any("writes outside the working folder" in line for line in not_enforced)
+    wrote = [l for l in out.splitlines() if l.startswith("wrote")]
+    assert out.count("no write") == len(outside) and set(wrote) <= {f"wrote {private}"}, out
+    assert not any(p.exists() for p in outside + [private])
+    solutions, checker, checkout = [l for l in out.splitlines() if l.startswith("listing:")]
+    assert solutions in ("listing: []", "listing: None") and checker == "listing: []", out
+    assert "'ikteach'" in checkout and "'instructor'" not in checkout, out  # only the package
+    assert "no network" in out and "uid 65534 caps [0]" in out, out
+    assert "umount -1" in out and "remount -1 -1" in out and "unshare -1" in out, out
+    assert "listing after: []" in out, out
 
 
-def test_without_bubblewrap_the_report_lists_what_is_not_enforced(tmp_path):
-    box = Sandbox([], bwrap=False)
+def test_the_probe_catches_a_sandbox_that_does_not_hold(monkeypatch):
+    """Take the network namespace away: verify() must refuse, not log "no network"."""
+    if not SANDBOXED:
+        return assert_refused()
+    monkeypatch.setattr(bwrap, "NAMESPACES", [a for a in bwrap.NAMESPACES if a != "--unshare-net"])
+    box = Sandbox([])
+    try:
+        with pytest.raises(SandboxUnavailable, match="reach the grader's machine over the network"):
+            box.verify()
+    finally:
+        box.close()
+
+
+def test_judge_states_only_what_held():
+    good = {"uid": 65534, "capabilities": 0, "read": [], "connected": False, "mounted": False,
+            "processes": 2, "userns_blocked": True}
+    lines = bwrap.judge(good, [], [Path("/srv/solutions")])
+    assert any("no capabilities" in l for l in lines) and any("PID namespace" in l for l in lines)
+    assert not any("user namespaces" in l for l in bwrap.judge(dict(good, userns_blocked=False),
+                                                                [], []))
+    for bad, why in [({"uid": 0}, "uid 0"), ({"capabilities": 1 << 21}, "keeps capabilities"),
+                     ({"read": ["/srv/solutions"]}, "read the hidden /srv/solutions"),
+                     ({"mounted": True}, "mount")]:
+        with pytest.raises(SandboxUnavailable, match=why):
+            bwrap.judge(dict(good, **bad), [], [])
+    with pytest.raises(SandboxUnavailable, match="write in /work"):
+        bwrap.judge(good, ["/work"], [])
+
+
+def test_without_a_sandbox_it_refuses_unless_told(tmp_path):
+    with pytest.raises(SandboxUnavailable) as refusal:
+        Sandbox([], bwrap=False)
+    assert "bubblewrap: not used" in str(refusal.value) and "--no-sandbox" in str(refusal.value)
+    box = Sandbox([], bwrap=False, unsandboxed=True)
     try:
         enforced, not_enforced = box.report()
-        assert box.bwrap is None and any("RLIMIT_CPU" in line for line in enforced)
-        assert any(line.startswith("network") for line in not_enforced)
+        assert box.bwrap is None and box.backend == "none (--no-sandbox)"
+        assert any("RLIMIT_CPU" in line for line in enforced)
+        assert any(line.startswith("ISOLATION: NONE") for line in not_enforced)
         assert run_in(box, tmp_path, "print('ran')")[1].strip() == "ran"
     finally:
         box.close()
 
 
-def test_the_grader_never_hides_its_own_python_or_ikteach(tmp_path):
-    import ikteach
-    box = Sandbox([Path(ikteach.__file__).parents[1], tmp_path])
+def test_blas_kernel_variables_reach_the_student_process(monkeypatch, tmp_path):
+    monkeypatch.setenv("OPENBLAS_CORETYPE", "Haswell")
+    monkeypatch.setenv("SECRET_TOKEN", "x")
+    box = Sandbox([], bwrap=False, unsandboxed=True)
     try:
-        assert Path(ikteach.__file__).parents[1] not in box.hidden and tmp_path in box.hidden
-        assert any("hiding" in line for line in box.report()[1])
+        env = box.environment(tmp_path)
+        assert env["OPENBLAS_CORETYPE"] == "Haswell" and "SECRET_TOKEN" not in env
     finally:
         box.close()
+
+
+def test_the_whitelist_holds_the_python_and_only_the_package():
+    paths = bwrap.python_paths(PACKAGE)
+    assert PACKAGE in paths and PACKAGE.parent not in paths  # not the checkout (solutions...)
+    assert any(Path(sys.executable).resolve().is_relative_to(p) for p in paths
+               + [Path(d).resolve() for d in bwrap.SYSTEM if os.path.isdir(d)])
+    assert Path.cwd().resolve() not in paths
+
+
+def test_the_command_line(tmp_path, monkeypatch):
+    """Nothing is run: /tmp private before a Python under /tmp is bound back, a hidden folder
+    inside a bound one covered read-only, an unprivileged user without capabilities."""
+    monkeypatch.setattr(bwrap, "python_paths", lambda package: [
+        Path("/tmp/course/.venv"), Path("/tmp/course/ikteach")])
+    hidden = [Path("/tmp/course/ikteach/course/check"), Path("/srv/solutions")]
+    (tmp_path / "x").mkdir()
+    monkeypatch.setattr(bwrap, "_is_dir", lambda path: True)
+    cmd = bwrap.command("bwrap", ["--disable-userns"], Path("/tmp/course/ikteach"), hidden,
+                        tmp_path / "x")
+    binds = [cmd[i + 1] for i, a in enumerate(cmd) if a == "--ro-bind"]
+    tmpfs = [cmd[i + 1] for i, a in enumerate(cmd) if a == "--tmpfs"]
+    assert "/tmp/course/.venv" in binds and "/tmp/course/ikteach" in binds
+    assert cmd.index("/tmp") < cmd.index("/tmp/course/.venv")  # private /tmp, then bind back
+    assert "/tmp/course/ikteach/course/check" in tmpfs and "/srv/solutions" not in cmd
+    at = cmd.index("/tmp/course/ikteach/course/check")
+    assert cmd[at + 1:at + 3] == ["--remount-ro", "/tmp/course/ikteach/course/check"]
+    for flag in (["--uid", "65534"], ["--cap-drop", "ALL"], ["--unshare-net"],
+                 ["--disable-userns"], ["--remount-ro", "/"]):
+        assert any(cmd[i:i + len(flag)] == flag for i in range(len(cmd))), flag
+    assert cmd[-1] == "--"
 
 
 def test_extraction_keeps_definitions_and_drops_the_rest():
@@ -122,22 +237,3 @@ def test_extraction_keeps_definitions_and_drops_the_rest():
     assert extract.code_cells(book) == [(2, "a = 1\nb = 2\n")]
     with pytest.raises(SyntaxError):
         extract.kept_statements("def (:")
-
-
-def test_a_python_under_tmp_is_bound_back_read_only(tmp_path):
-    # bubblewrap gives the run a private /tmp: a checkout or venv there must be bound back
-    box = Sandbox([tmp_path / "class"], bwrap="/usr/bin/bwrap")
-    try:
-        box.bwrap = "/usr/bin/bwrap"  # the command line only; nothing is run
-        box.needed = [Path("/tmp/course/.venv"), Path("/tmp/course/ikteach"), Path("/usr")]
-        box.hidden = [Path("/tmp/course/.venv/secret"), Path("/tmp/other"), Path("/srv/solutions")]
-        cmd = box.command(["python", "-c", "1"], tmp_path, None)
-        binds = [cmd[i + 1] for i, a in enumerate(cmd) if a == "--ro-bind"]
-        tmpfs = [cmd[i + 1] for i, a in enumerate(cmd) if a == "--tmpfs"]
-        assert "/tmp/course/.venv" in binds and "/tmp/course/ikteach" in binds
-        assert "/usr" not in binds[1:]  # outside /tmp: already there via the read-only root
-        assert "/tmp/course/.venv/secret" in tmpfs and "/srv/solutions" in tmpfs
-        assert "/tmp/other" not in tmpfs  # gone with the private /tmp anyway
-        assert cmd.index("/tmp/course/.venv") < cmd.index("/tmp/course/.venv/secret")  # bind, then hide
-    finally:
-        box.close()

@@ -1,21 +1,31 @@
 """Grade the students' exercise notebooks.
 
     python -m ikteach.course.grade SUBMISSIONS_DIR --out grades.csv [--feedback DIR] [--timeout S]
-                            [--jobs N] [--memory-mb M] [--no-bwrap]
+                            [--grade-timeout S] [--jobs N] [--memory-mb M] [--no-sandbox]
     python -m ikteach.course.grade --gradescope OUT.zip      (a Gradescope autograder bundle)
 
 SUBMISSIONS_DIR holds one folder per student (the folder name is the student), each with that
 student's exercise notebooks (NN_name.ipynb, as handed out). For each notebook:
 
-1. its cells run in a kernel in a sandbox (ikteach.course.grading.sandbox: own temporary folder and
-   HOME, resource limits, and with bubblewrap no network, read-only file system, solutions and
-   other students hidden), for its errors and notes only - nothing it prints counts;
+1. its cells run in a kernel in a sandbox (ikteach.course.grading.sandbox: bubblewrap, an
+   unprivileged user without capabilities, no network, a read-only whitelist of the machine,
+   resource limits; where no sandbox works the grader refuses unless --no-sandbox), for its
+   errors and notes only - nothing it prints counts;
 2. the student's functions are taken from the notebook's source (top-level imports,
    definitions and assignments, by the AST) into a second sandboxed process, and ik.check runs
    in the grader's own process, calling them there through a pipe (each call under its time
    limit). So nothing a notebook does to modules, builtins, stdout or files changes a score.
+   In that process ikteach's own answer to the exercise raises, the checker cannot be imported,
+   and a graded name that is not a function written in the notebook gets 0 (grading/own_code.py).
 
-Writes one CSV row per student (ex1..ex6 and total) and a feedback file per student
+Before anyone is graded the sandbox is probed (the log states only what the probe saw hold)
+and a known-good answer must get full marks (grading/selfcheck.py); if either fails the grader
+stops with a non-zero exit status. The submissions folder is not trusted (grading/submissions.py):
+a symlink, FIFO, directory or malformed notebook costs only its student's marks, with a reason
+in the CSV's `notes`. Each notebook's cells get --timeout seconds and its checks
+--grade-timeout, both enforced from outside (the process group is killed).
+
+Writes one CSV row per student (ex1..ex7, total, sandbox, notes) and a feedback file per student
 (FEEDBACK/<student>.txt, by default a `feedback` folder next to the CSV); the log starts with
 what the sandbox enforces and what it cannot on this machine.
 """
@@ -29,19 +39,23 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
 from pathlib import Path
 
 from .exercises import ANSWER_PLACEHOLDER
+from .grading.report import EXERCISE_NUMBERS, POINTS, write_results
+from .grading.submissions import MAX_NOTEBOOK_BYTES, notebooks, read_notebook, students, text
 
 NOTEBOOK_TIMEOUT = 120.0  # seconds for all of a student's cells
-GRADE_TIMEOUT = 180.0     # kept for the command line; each check call has its own limit
-EXERCISE_NUMBERS = range(1, 8)
-POINTS = 10
-MAX_NOTEBOOK_BYTES = 20 << 20
+GRADE_TIMEOUT = 180.0     # seconds for the checks' worker: start-up and every call
+GRACE = 15.0              # the runner's own limit comes first; then it is killed from outside
 RUNNER = Path(__file__).with_name("grading") / "run_notebook.py"
 INSTRUCTOR = Path(__file__).resolve().parents[2] / "instructor"  # the solutions: hidden
+
+__all__ = ["grade_all", "grade_notebook", "grade_book", "exercise_number", "main",
+           "MAX_NOTEBOOK_BYTES"]
 
 
 def exercise_number(path, book):
@@ -57,25 +71,12 @@ def exercise_number(path, book):
     return None
 
 
-def _read_book(path):
-    """The notebook as a dict, or a message saying why it is not one."""
-    if path.stat().st_size > MAX_NOTEBOOK_BYTES:
-        return None, f"the notebook is larger than {MAX_NOTEBOOK_BYTES >> 20} MB"
-    try:
-        book = json.loads(path.read_text(encoding="utf-8", errors="replace"))
-    except ValueError as exc:
-        return None, f"could not read the notebook: it is not JSON ({exc})"
-    if not isinstance(book, dict) or not isinstance(book.get("cells"), list):
-        return None, "could not read the notebook: no list of cells in it"
-    return book, None
-
-
-def _run_cells(path, work, sandbox, timeout):
+def _run_cells(book, work, sandbox, timeout):
     """Run the notebook's cells in the sandbox; (error lines, notes) from the runner's report."""
     run_dir = work / "run"
     run_dir.mkdir()
-    copy = run_dir / path.name
-    shutil.copy(path, copy)
+    copy = run_dir / "notebook.ipynb"  # the parsed, clean notebook: never the student's file
+    copy.write_text(json.dumps(book))
     read_end, write_end = os.pipe()
     try:
         process = sandbox.start([sys.executable, str(RUNNER), str(copy), f"{timeout:g}",
@@ -85,7 +86,7 @@ def _run_cells(path, work, sandbox, timeout):
     finally:
         os.close(write_end)
     try:
-        status = process.wait(timeout + 60)
+        status = process.wait(timeout + GRACE)  # killed there, whatever it does with signals
     finally:
         process.end()
     report = b""
@@ -99,7 +100,8 @@ def _run_cells(path, work, sandbox, timeout):
         data = json.loads(report.decode(errors="replace").splitlines()[0])
         return [str(e)[:400] for e in data["errors"]][:30], [str(n)[:400] for n in data["notes"]][:10]
     except (ValueError, IndexError, KeyError, TypeError):
-        why = "it ran past its time limit" if status is None else f"exit status {status}"
+        why = (f"it ran past the time limit of {timeout:g} s and was killed" if status is None
+               else f"exit status {status}")
         return [], [f"the notebook's run ended without a report ({why}: a crash, or a CPU, "
                     "memory or file-size limit)"]
 
@@ -112,13 +114,13 @@ def _answer_text(book):
         tags = meta.get("tags") if isinstance(meta, dict) else None
         if cell.get("cell_type") == "markdown" and isinstance(tags, list) and "answer" in tags:
             source = cell.get("source", "")
-            text = "".join(source) if isinstance(source, list) else str(source)
-            if text.strip() != ANSWER_PLACEHOLDER:  # the template's, untouched
-                texts.append(text)
+            text_ = "".join(map(str, source)) if isinstance(source, list) else str(source)
+            if text_.strip() != ANSWER_PLACEHOLDER:  # the template's, untouched
+                texts.append(text_)
     return "\n".join(texts)[:4000]
 
 
-def _check(number, book, work, sandbox):
+def _check(number, book, work, sandbox, grade_timeout):
     """The verdict from ik.check in this process, on the student's functions in a worker."""
     from . import check
     from .grading.extract import code_cells
@@ -126,42 +128,46 @@ def _check(number, book, work, sandbox):
 
     check_dir = work / "check"
     check_dir.mkdir()
-    worker = Worker(code_cells(book), sandbox, check_dir)
+    module = check.EXERCISES[number]
+    worker = Worker(code_cells(book), sandbox, check_dir, exercise=number,
+                    references=module.REFERENCES, graded=module.FUNCTIONS, limit=grade_timeout)
     try:
         try:
             worker.start()
         except (ProcessEnded, ValueError) as exc:  # died, hung, or answered garbage
             return None, [f"your code could not be loaded for the checks: {exc}"]
+        if worker.foreign:  # a graded name bound to ikteach's (or anyone's) code: no marks
+            return check.registry.refuse(number, " ".join(worker.foreign.values())), worker.notes
         namespace = {name: worker.function(name) for name in worker.names}
         return check.grade(number, namespace), worker.notes
     finally:
         worker.end()
 
 
-def grade_notebook(path, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT, sandbox=None):
-    """Grade one notebook; returns a dict: file, exercise, score, max, status, message,
+def _result(name, number=None, message=""):
+    return {"file": text(name), "exercise": number, "score": 0.0, "max": float(POINTS),
+            "status": "not graded", "message": message, "notes": [], "answer": ""}
+
+
+def grade_book(name, book, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT,
+               sandbox=None, run_cells=True):
+    """Grade one notebook (a dict); returns a dict: file, exercise, score, max, status, message,
     notes (what went wrong on the way), answer (the written answer, if any)."""
     from .grading.sandbox import Sandbox
 
-    sandbox = sandbox or Sandbox()
-    path = Path(path)
-    result = {"file": path.name, "exercise": None, "score": 0.0, "max": float(POINTS),
-              "status": "not graded", "message": "", "notes": [], "answer": ""}
-    book, problem = _read_book(path)
-    if book is None:
-        result["message"] = problem
-        return result
-    number = exercise_number(path, book)
-    result["exercise"] = number
+    sandbox = sandbox or Sandbox()  # raises SandboxUnavailable where there is none
+    number = exercise_number(name, book)
+    result = _result(name, number)
     if number is None:
         result["message"] = ("not an exercise notebook (no ikteach exercise number in its "
                              "metadata or name)")
         return result
     work = Path(tempfile.mkdtemp(prefix="nb-", dir=sandbox.work_root))
+    started = time.monotonic()
     try:
         result["answer"] = _answer_text(book)
-        errors, notes = _run_cells(path, work, sandbox, timeout)
-        verdict, check_notes = _check(number, book, work, sandbox)
+        errors, notes = _run_cells(book, work, sandbox, timeout) if run_cells else ([], [])
+        verdict, check_notes = _check(number, book, work, sandbox, grade_timeout)
         result["notes"] = errors + notes + check_notes
         if verdict is None:
             result["message"] = "no grade: your code could not be loaded for the checks"
@@ -172,109 +178,109 @@ def grade_notebook(path, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT, 
         result["message"] = f"could not grade the notebook: {type(exc).__name__}: {exc}"
     finally:
         shutil.rmtree(work, ignore_errors=True)
+        result["seconds"] = time.monotonic() - started
     return result
 
 
-def _students(submissions):
-    if submissions is None or not Path(submissions).is_dir():
-        raise ValueError(f"SUBMISSIONS_DIR: expected a folder of student folders, "
-                         f"got {str(submissions)!r}")
-    return sorted(p for p in Path(submissions).iterdir() if p.is_dir() and not p.name.startswith("."))
+def grade_notebook(path, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT, sandbox=None,
+                   problem=None):
+    """Grade one notebook file (read as untrusted: see grading/submissions.py)."""
+    from .grading.sandbox import Sandbox
+
+    sandbox = sandbox or Sandbox()  # raises SandboxUnavailable where there is none
+    path = Path(path)
+    number = exercise_number(path, None)
+    if problem is None:
+        book, problem = read_notebook(path)
+    if problem is not None:
+        return _result(path.name, number, problem)
+    try:
+        return grade_book(path.name, book, timeout, grade_timeout, sandbox)
+    except Exception as exc:  # noqa: BLE001 - one notebook's failure is its own
+        return _result(path.name, number, f"could not grade the notebook: {type(exc).__name__}")
 
 
-def _feedback_text(student, results):
-    lines = [f"Feedback for {student}", ""]
-    by_number = {r["exercise"]: r for r in results if r["exercise"] is not None}
-    for number in EXERCISE_NUMBERS:
-        r = by_number.get(number)
-        if r is None:
-            lines.append(f"Exercise {number}: 0/{POINTS} - no notebook submitted")
-            continue
-        lines.append(f"Exercise {number} ({r['file']}): {r['score']:g}/{r['max']:g}")
-        for text in r["message"].splitlines():
-            lines.append(f"  {text}")
-        for note in r["notes"]:
-            lines.append(f"  note: {note}")
-        if r.get("answer", "").strip():
-            lines.append("  your written answer (not marked by the checker; read by the "
-                         "instructor):")
-            lines += [f"    | {text}" for text in r["answer"].strip().splitlines()]
-    for r in results:
-        if r["exercise"] is None:
-            lines.append(f"{r['file']}: {r['message']}")
-    total = sum(r["score"] for r in by_number.values())
-    lines += ["", f"Total: {total:g}/{POINTS * len(EXERCISE_NUMBERS)}"]
-    return "\n".join(lines) + "\n"
-
-
-def _best(results):
-    """One result per exercise (the best, if a student handed in two for the same one)."""
-    best = {}
-    for r in results:
-        number = r["exercise"]
-        if number is not None and (number not in best or r["score"] > best[number]["score"]):
-            best[number] = r
-    return best
+def _grade_jobs(jobs_list, jobs, timeout, grade_timeout, sandbox):
+    """Every notebook's result, in order; a worker that dies costs only its notebooks."""
+    if jobs <= 1:
+        return [grade_notebook(nb, timeout, grade_timeout, sandbox, problem)
+                for _, nb, problem in jobs_list]
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
+        futures = [pool.submit(grade_notebook, nb, timeout, grade_timeout, sandbox, problem)
+                   for _, nb, problem in jobs_list]
+        outcomes = []
+        for (_, nb, _), future in zip(jobs_list, futures):
+            try:
+                outcomes.append(future.result())
+            except Exception as exc:  # noqa: BLE001 - a crashed grading process
+                outcomes.append(_result(os.path.basename(nb), None, "could not grade the "
+                                        f"notebook: the grading process failed ({exc!r:.200})"))
+    return outcomes
 
 
 def grade_all(submissions, out, feedback=None, timeout=NOTEBOOK_TIMEOUT, jobs=1,
-              grade_timeout=GRADE_TIMEOUT, log=print, limits=None, bwrap=None, collect=None):
+              grade_timeout=GRADE_TIMEOUT, log=print, limits=None, bwrap=None, collect=None,
+              unsandboxed=False, warn=None):
     """Grade every student folder; write the CSV and the feedback files; return the rows
-    (`collect`: a list that receives every notebook's result dict)."""
+    (`collect`: a list that receives every notebook's result dict). Raises SandboxUnavailable
+    (no sandbox, and not `unsandboxed`) or SelfCheckFailed before grading anyone."""
+    from .grading import selfcheck
     from .grading.sandbox import Limits, Sandbox
 
-    students = _students(submissions)
+    if submissions is None or not Path(submissions).is_dir():
+        raise ValueError(f"SUBMISSIONS_DIR: expected a folder of student folders, "
+                         f"got {str(submissions)!r}")
+    found, ignored = students(submissions)
     out = Path(out)
     feedback = Path(feedback) if feedback else out.parent / "feedback"
-    feedback.mkdir(parents=True, exist_ok=True)
-    hidden = [submissions, out.parent, feedback, INSTRUCTOR]
-    sandbox = Sandbox(hidden, limits or Limits(), bwrap=bwrap)
-    enforced, not_enforced = sandbox.report()
-    log("sandbox: enforced:")
-    for line in enforced:
-        log(f"  + {line}")
-    log("sandbox: NOT enforced:")
-    for line in not_enforced:
-        log(f"  - {line}")
-    jobs_list = [(s.name, nb) for s in students for nb in sorted(s.glob("*.ipynb"))]
+    hidden = [submissions, out.parent, feedback, INSTRUCTOR, Path.cwd() / "instructor"]
+    sandbox = Sandbox(hidden, limits or Limits(), bwrap=bwrap, unsandboxed=unsandboxed)
     try:
-        if jobs > 1:
-            with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
-                futures = [pool.submit(grade_notebook, nb, timeout, grade_timeout, sandbox)
-                           for _, nb in jobs_list]
-                outcomes = [f.result() for f in futures]
-        else:
-            outcomes = [grade_notebook(nb, timeout, grade_timeout, sandbox) for _, nb in jobs_list]
+        if sandbox.unsandboxed:
+            (warn or (lambda m: print(m, file=sys.stderr)))(
+                "WARNING: --no-sandbox: every student's code runs WITHOUT isolation, with "
+                "your user's rights (files, network). The CSV records it.")
+        sandbox.verify()
+        enforced, not_enforced = sandbox.report()
+        log(f"sandbox: {sandbox.backend}; enforced:")
+        for line in enforced:
+            log(f"  + {line}")
+        log("sandbox: NOT enforced:")
+        for line in not_enforced:
+            log(f"  - {line}")
+        selfcheck.run(grade_book, sandbox, timeout, grade_timeout)
+        log("self-check: a known-good answer got 10/10 and a wrapper of ikteach's own got 0")
+        for name in ignored:
+            log(f"ignored (not a student folder): {text(name)}")
+        jobs_list, per_student, notes = [], {}, {}
+        for name, folder, problem in found:
+            per_student[name], notes[name] = [], []
+            if problem:
+                notes[name].append(problem)
+                continue
+            try:
+                books = notebooks(folder)
+            except OSError as exc:
+                notes[name].append(f"the folder could not be read: {exc.strerror or exc}")
+                continue
+            jobs_list += [(name, path, why) for _, path, why in books]
+        outcomes = _grade_jobs(jobs_list, jobs, timeout, grade_timeout, sandbox)
     finally:
         sandbox.close()
     if collect is not None:
         collect.extend(outcomes)
-    per_student = {s.name: [] for s in students}
-    for (student, _), result in zip(jobs_list, outcomes):
+    for (student, path, problem), result in zip(jobs_list, outcomes):
         per_student[student].append(result)
-        log(f"{student}/{result['file']}: {result['score']:g}/{result['max']:g} {result['status']}")
-
-    rows = []
-    for student, results in per_student.items():
-        best = _best(results)
-        row = {"student": student}
-        for number in EXERCISE_NUMBERS:
-            row[f"ex{number}"] = best[number]["score"] if number in best else 0.0
-        row["total"] = sum(row[f"ex{n}"] for n in EXERCISE_NUMBERS)
-        rows.append(row)
-        (feedback / f"{student}.txt").write_text(_feedback_text(student, results))
-    out.parent.mkdir(parents=True, exist_ok=True)
-    with open(out, "w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=["student"]
-                                + [f"ex{n}" for n in EXERCISE_NUMBERS] + ["total"])
-        writer.writeheader()
-        for row in rows:
-            writer.writerow({k: (f"{v:g}" if isinstance(v, float) else v) for k, v in row.items()})
-    return rows
+        if problem or result["status"] == "not graded":
+            notes[student].append(f"{result['file']}: {result['message']}")
+        log(f"{text(student)}/{result['file']}: {result['score']:g}/{result['max']:g} "
+            f"{result['status']} ({result.get('seconds', 0.0):.0f} s)")
+    return write_results(per_student, notes, out, feedback, sandbox.backend)
 
 
 def main(argv=None):
-    from .grading.sandbox import Limits
+    from .grading.sandbox import OVERRIDE, Limits, SandboxUnavailable
+    from .grading.selfcheck import SelfCheckFailed
 
     parser = argparse.ArgumentParser(prog="python -m ikteach.course.grade",
                                      description="Grade exercise notebooks, one folder per "
@@ -286,14 +292,18 @@ def main(argv=None):
     parser.add_argument("--timeout", type=float, default=NOTEBOOK_TIMEOUT,
                         help="seconds allowed for one notebook's cells (default %(default)s)")
     parser.add_argument("--grade-timeout", type=float, default=GRADE_TIMEOUT,
-                        help="seconds allowed for the grader's checks (default %(default)s)")
+                        help="seconds allowed for one notebook's checks (default %(default)s)")
     parser.add_argument("--jobs", type=int, default=1, help="notebooks graded at once")
     parser.add_argument("--memory-mb", type=int, default=Limits.memory_mb,
                         help="address space of one student process (default %(default)s)")
     parser.add_argument("--cpu-s", type=int, default=Limits.cpu_seconds,
                         help="CPU seconds of one student process (default %(default)s)")
     parser.add_argument("--no-bwrap", action="store_true",
-                        help="do not use bubblewrap even where it works")
+                        help="do not use bubblewrap even where it works (then only "
+                             f"{OVERRIDE} grades)")
+    parser.add_argument(OVERRIDE, dest="no_sandbox", action="store_true",
+                        help="where no sandbox works, run students' code WITHOUT isolation "
+                             "(warned on stderr, recorded in the CSV)")
     parser.add_argument("--gradescope", metavar="OUT.zip",
                         help="write a Gradescope autograder bundle instead of grading")
     args = parser.parse_args(argv)
@@ -307,9 +317,15 @@ def main(argv=None):
     try:
         rows = grade_all(args.submissions, args.out, args.feedback, args.timeout, args.jobs,
                          args.grade_timeout, limits=limits,
-                         bwrap=False if args.no_bwrap else None)
+                         bwrap=False if args.no_bwrap else None, unsandboxed=args.no_sandbox)
     except ValueError as exc:
         parser.error(str(exc))
+    except SandboxUnavailable as exc:
+        print(f"grade: refused: {exc}", file=sys.stderr)
+        return 2
+    except SelfCheckFailed as exc:
+        print(f"grade: stopped: {exc}", file=sys.stderr)
+        return 3
     print(f"wrote {args.out}: {len(rows)} student(s)")
     return 0
 

@@ -112,6 +112,67 @@ for _ in range(150):  # 150 MB of output
     print(line)
 '''
 
+# --- marks only for the student's own code (issue 24, class 1) -------------------------------
+REF_PLAIN = "def jt_step(J, e):\n    return ik.jt_step(J, e)\n"
+REF_IMPORT = "from ikteach.core.jt import jt_step\n"
+REF_DECORATOR = '''\
+def _use_library(f):
+    return ik.pinv_step
+
+
+@_use_library
+def pinv_step(J, e, rcond):
+    raise NotImplementedError
+'''
+REF_DEFAULT = '''\
+def dls_step(J, e, damping, _ref=ik.dls_step):
+    return _ref(J, e, damping)
+
+
+def dls_step_normal(J, e, damping, _ref=ik.dls_step_normal):
+    return _ref(J, e, damping)
+'''
+REF_CLASS = '''\
+class _Library:
+    planar_jacobian = staticmethod(lambda lengths, theta: ik.jacobian(ik.planar_chain(lengths), theta))
+
+
+planar_jacobian = _Library.planar_jacobian
+'''
+REF_ANNOTATION = "priority_step: ik.priority_step = ik.priority_step\n"
+REF_CHECKER = '''\
+def study(jt_step, pinv_step, dls_step):
+    return ik.check.ex06_singularity_study._reference_study()
+'''
+REF_CHECKER_REIMPORT = '''\
+def study(jt_step, pinv_step, dls_step):
+    """Undo the worker's import block, import the checker afresh, return its answers."""
+    import importlib, sys
+    sys.meta_path[:] = [f for f in sys.meta_path if type(f).__name__ != "_NoChecker"]
+    for name in [n for n in sys.modules if n.startswith("ikteach.course.check")]:
+        del sys.modules[name]
+    return importlib.import_module("ikteach.course.check.ex06_singularity_study")._reference_study()
+'''
+
+# --- time limits the student can switch off (class 3); the sandbox as root (class 4) -----------
+SIGALRM_SLEEP = '''\
+import signal, time
+_alarm = signal.signal(signal.SIGALRM, signal.SIG_IGN)
+_interrupt = signal.signal(signal.SIGINT, signal.SIG_IGN)
+_forever = time.sleep(10**6)
+'''
+REMOUNT_PLANT = '''\
+import ctypes, pathlib
+_libc = ctypes.CDLL(None, use_errno=True)
+_package = pathlib.Path(ik.__file__).parent
+_detach = _libc.umount2(str(_package / "course" / "check").encode(), 2)
+_remount_root = _libc.mount(None, b"/", None, 32 | 4096, None)
+_remount_package = _libc.mount(None, str(_package).encode(), None, 32 | 4096, None)
+_new_userns = _libc.unshare(0x10000000)
+_plant = (_package / "course" / "planted_by_student.py").write_text("FULL_MARKS = True\\n")
+_plant2 = (_package.parent / "planted_by_student.py").write_text("FULL_MARKS = True\\n")
+'''
+
 
 def notebook(base, extra_cells, before_check=True):
     """A copy of `base` with code cells added before its check cell (or at the end)."""
@@ -132,6 +193,17 @@ def replace_function(base, source):
     """`base` with its solution cell (the one defining the first name of source) replaced."""
     book = nbformat.read(base, as_version=4)
     name = source.split("def ", 1)[1].split("(", 1)[0]
+    for cell in book.cells:
+        if cell.cell_type == "code" and f"def {name}(" in cell.source:
+            cell.source = source
+        if cell.cell_type == "code":
+            cell.outputs, cell.execution_count = [], None
+    return book
+
+
+def replace_cell(base, name, source):
+    """`base` with the cell that defines `name` replaced by `source` (any statement kind)."""
+    book = nbformat.read(base, as_version=4)
     for cell in book.cells:
         if cell.cell_type == "code" and f"def {name}(" in cell.source:
             cell.source = source
@@ -165,6 +237,21 @@ def main():
     empty.cells = [nbformat.v4.new_markdown_cell("# Exercise 3"),
                    nbformat.v4.new_code_cell("print('I did not write any function')")]
     write("no_functions", "03_pinv_step.ipynb", empty)
+    write("ref_plain", "02_jt_step.ipynb", replace_cell(SOLUTION / "02_jt_step.ipynb", "jt_step", REF_PLAIN))
+    write("ref_import", "02_jt_step.ipynb", replace_cell(SOLUTION / "02_jt_step.ipynb", "jt_step", REF_IMPORT))
+    write("ref_decorator", "03_pinv_step.ipynb",
+          replace_cell(SOLUTION / "03_pinv_step.ipynb", "pinv_step", REF_DECORATOR))
+    write("ref_default", "04_dls_step.ipynb", replace_cell(SOLUTION / "04_dls_step.ipynb", "dls_step", REF_DEFAULT))
+    write("ref_class", "01_jacobian.ipynb",
+          replace_cell(SOLUTION / "01_jacobian.ipynb", "planar_jacobian", REF_CLASS))
+    write("ref_annotation", "07_priority_step.ipynb",
+          replace_cell(SOLUTION / "07_priority_step.ipynb", "priority_step", REF_ANNOTATION))
+    write("ref_checker", "06_singularity_study.ipynb",
+          replace_cell(SOLUTION / "06_singularity_study.ipynb", "study", REF_CHECKER))
+    write("ref_checker_reimport", "06_singularity_study.ipynb",
+          replace_cell(SOLUTION / "06_singularity_study.ipynb", "study", REF_CHECKER_REIMPORT))
+    write("sigalrm_sleep", "02_jt_step.ipynb", notebook(SOLUTION / "02_jt_step.ipynb", [SIGALRM_SLEEP]))
+    write("remount_plant", "02_jt_step.ipynb", notebook(SOLUTION / "02_jt_step.ipynb", [REMOUNT_PLANT]))
 
 
 if __name__ == "__main__":

@@ -15,6 +15,7 @@ by parts, the Verdict), one module per exercise (``ex01_jacobian.py`` ...), ``re
 To add exercise N: write ``exNN_<topic>.py`` with
     NUMBER = N; CHECK_NAME = "<name>" (so ik.check.<name>); TITLE = "..."
     FUNCTIONS = ("student_fn", ...)        # the names the template defines, in call order
+    REFERENCES = ("ikteach.core.x:fn", ...)  # ikteach's own answer: blocked while grading
     def verdict(*functions) -> Verdict     # build [_Part(name, points, run), ...] (points sum
                                            # to POINTS; run() returns None or the message of
                                            # the smallest failing case) and return

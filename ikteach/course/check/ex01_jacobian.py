@@ -14,6 +14,15 @@ NUMBER = 1
 CHECK_NAME = "jacobian"
 TITLE = "the geometric Jacobian"
 FUNCTIONS = ("planar_jacobian",)
+# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
+REFERENCES = ("ikteach.core.jacobian:jacobian",
+              "ikteach.core.jacobian:jacobian_from_frames",
+              "ikteach.core.jacobian:jacobian_autodiff",
+              "ikteach.core.jacobian:jacobian_fd",
+              "ikteach.core.tree:tree_jacobian",
+              "ikteach.core.tree:tree_jacobian_from_frames",
+              "ikteach.core.tree:tree_jacobian_autodiff",
+)
 
 
 def _jacobian_cases():

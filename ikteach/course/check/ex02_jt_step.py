@@ -13,6 +13,8 @@ NUMBER = 2
 CHECK_NAME = "jt_step"
 TITLE = "the Jacobian-transpose step"
 FUNCTIONS = ('jt_step',)
+# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
+REFERENCES = ("ikteach.core.jt:jt_step", "ikteach.core.jt:optimal_alpha")
 
 def _step_cases(shapes_seed, count=12, extra=()):
     rng = np.random.default_rng(shapes_seed)

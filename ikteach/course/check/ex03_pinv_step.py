@@ -13,6 +13,8 @@ NUMBER = 3
 CHECK_NAME = "pinv_step"
 TITLE = "the pseudoinverse step"
 FUNCTIONS = ('pinv_step',)
+# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
+REFERENCES = ("ikteach.core.pinv:pinv_step", "ikteach.core.pinv:pinv_two_rows")
 
 def _pinv_cases():
     rng = np.random.default_rng(SEED + 3)

@@ -17,6 +17,11 @@ NUMBER = 5
 CHECK_NAME = "stop_rule"
 TITLE = "the out-of-reach stop rule"
 FUNCTIONS = ('stalled', 'stop_rule_step')
+# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
+REFERENCES = ("ikteach.core.stop_rules:joint_steps",
+              "ikteach.core.stop_rules:motion",
+              "ikteach.core.stop_rules:step_size",
+)
 
 STOP_ARM = [1.0, 1.0, 1.0]
 STOP_TARGET = [4.0, 0.5]      # out of reach: the arm is 3 long

@@ -19,6 +19,8 @@ NUMBER = 6
 CHECK_NAME = "singularity_study"
 TITLE = "a singularity study"
 FUNCTIONS = ('study',)
+# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
+REFERENCES = ()
 
 STUDY_ARM = [1.0, 1.0, 1.0]
 STUDY_THETA0 = [0.3, 0.2, 0.1]

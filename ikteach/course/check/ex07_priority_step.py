@@ -13,6 +13,11 @@ NUMBER = 7
 CHECK_NAME = "priority_step"
 TITLE = "the priority step"
 FUNCTIONS = ("priority_step",)
+# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
+REFERENCES = ("ikteach.core.priority:priority_step",
+              "ikteach.core.priority:multilevel_step",
+              "ikteach.core.priority:null_space_step",
+)
 
 
 def _ref_priority(J1, e1, J2, e2, lam):

@@ -22,3 +22,11 @@ def grade(number, namespace):
             "function names of the template."))]
         return _evaluate(number, module.TITLE, list(module.FUNCTIONS), parts)
     return module.verdict(*(namespace[n] for n in module.FUNCTIONS))
+
+
+def refuse(number, message):
+    """A 0 verdict for exercise `number` that says why (the grader's, e.g. a graded function
+    that is not the student's own code)."""
+    module = EXERCISES[number]
+    return _evaluate(number, module.TITLE, list(module.FUNCTIONS),
+                     [_Part("own code", POINTS, lambda: message)])

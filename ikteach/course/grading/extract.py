@@ -27,7 +27,7 @@ def code_cells(book):
     for index, cell in enumerate(book.get("cells", [])):
         if isinstance(cell, dict) and cell.get("cell_type") == "code":
             source = cell.get("source", "")
-            source = "".join(source) if isinstance(source, list) else str(source)
+            source = "".join(map(str, source)) if isinstance(source, list) else str(source)
             cells.append((index + 1, python_source(source)))
     return cells
 

@@ -19,6 +19,7 @@ import os
 import select
 import signal
 import sys
+import time
 import traceback
 
 STATEMENT_LIMIT = 20.0   # seconds for one top-level statement of the student's code
@@ -166,14 +167,18 @@ def worker():
     for fd in (0, 1):
         os.dup2(null, fd)  # the student's prints and input() see nothing of the protocol
     from ikteach.core.solve import StopSolve
+    from ikteach.course.grading import own_code
 
     def send(message):
         replies.write(json.dumps(message) + "\n")
         replies.flush()
 
-    namespace, notes = _define(json.loads(requests.readline())["cells"])
+    setup = json.loads(requests.readline())
+    own_code.block_checker()  # before any student statement: nothing of it is reachable
+    own_code.block(setup.get("references", []), setup.get("exercise"))
+    namespace, notes = _define(setup["cells"])
     send({"ready": sorted(k for k, v in namespace.items() if callable(v) and k[:2] != "__"),
-          "notes": notes})
+          "notes": notes, "foreign": own_code.foreign(namespace, setup.get("graded", []))})
     handles = []
     for line in requests:
         request = json.loads(line)
@@ -197,21 +202,38 @@ def worker():
 # --- the grader's side ------------------------------------------------------------------------------
 
 class Worker:
-    """One worker process for one notebook's code, started in a sandbox on first use."""
+    """One worker process for one notebook's code, started in a sandbox on first use.
+    exercise, references, graded: the exercise number, ikteach's functions to block (its check
+    module's REFERENCES) and the names the check grades; `limit`: seconds for the whole worker
+    (start-up and every call), applied from here: the process is then killed, whatever it does
+    with its signals."""
 
-    def __init__(self, cells, sandbox, work):
+    def __init__(self, cells, sandbox, work, exercise=None, references=(), graded=(),
+                 limit=STARTUP_LIMIT + CALL_LIMIT):
         self.cells, self.sandbox, self.work = cells, sandbox, work
-        self.process, self.names, self.notes = None, [], []
+        self.setup = {"cells": cells, "exercise": exercise, "references": list(references),
+                      "graded": list(graded)}
+        self.limit, self.deadline = limit, None
+        self.process, self.names, self.notes, self.foreign = None, [], [], {}
 
     def start(self):
+        import subprocess
+
+        self.deadline = time.monotonic() + self.limit
         self.process = self.sandbox.start([sys.executable, "-m", "ikteach.course.grading.remote"],
-                                          self.work, stdin=__import__("subprocess").PIPE,
-                                          stdout=__import__("subprocess").PIPE,
-                                          stderr=__import__("subprocess").DEVNULL)
-        self._write({"cells": self.cells})
-        ready = self._read(STARTUP_LIMIT + STATEMENT_LIMIT * len(self.cells))
+                                          self.work, stdin=subprocess.PIPE,
+                                          stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
+        try:
+            self._write(self.setup)
+            ready = self._read(STARTUP_LIMIT + STATEMENT_LIMIT * len(self.cells))
+        except BaseException:
+            self.end()
+            raise
         self.names = [str(n) for n in ready.get("ready", [])]
         self.notes = [str(n)[:300] for n in ready.get("notes", [])][:20]
+        foreign = ready.get("foreign", {})
+        self.foreign = {str(k): str(v)[:400] for k, v in foreign.items()} \
+            if isinstance(foreign, dict) else {}
         return self
 
     def _write(self, message):
@@ -222,8 +244,12 @@ class Worker:
     def _read(self, timeout):
         fd, chunks, size = self.process.proc.stdout.fileno(), [], 0
         while True:
-            ready, _, _ = select.select([fd], [], [], timeout)
+            left = self.deadline - time.monotonic()
+            ready, _, _ = select.select([fd], [], [], max(0.0, min(timeout, left)))
             if not ready:
+                if left <= timeout:
+                    raise ProcessEnded(f"your code ran past the grading time limit of "
+                                       f"{self.limit:g} s: it was stopped")
                 raise ProcessEnded(f"no answer within {timeout:g} s")
             chunk = os.read(fd, 1 << 20)
             if not chunk:

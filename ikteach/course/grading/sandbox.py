@@ -1,27 +1,47 @@
-"""Each student process runs in a sandbox, as far as this machine allows.
+"""Each student process runs in a sandbox; without one the grader refuses to run student code
+(unless told: `unsandboxed=True`, the grader's --no-sandbox).
 
-Always: its own temporary working folder and HOME, a bare environment, resource limits
-(CPU time, address space, file size, no core files), its own process group (ended as a whole).
-Where bubblewrap (`bwrap`, Debian package `bubblewrap`) runs: no network, the whole file
-system read-only except its working folder, /tmp private, the instructor's solutions, the
-submissions and the grader's output hidden, its own PID namespace (every process it started
-dies with it). Where the cgroup v1 `pids` controller is writable: a cap on its processes
-(RLIMIT_NPROC caps them for a non-root grader; it does not apply to root).
-`Sandbox().report()` says what was and was not enforced; the grader logs it.
+Backend: bubblewrap (`bwrap`; Debian/Ubuntu/Fedora/Arch package `bubblewrap`), see bwrap.py. A
+run sees a read-only whitelist of the machine (system libraries, a few files of /etc, the
+Python the grader runs on, ikteach's package without its checker) and its own working folder;
+/tmp private; no network; own PID, IPC and UTS namespaces; its own user namespace as an
+unprivileged uid with no capabilities, also when the grader runs as root.
+Always: own HOME, bare environment (BLAS kernel variables passed through, so that the student's
+numbers come from the same kernels as the grader's), resource limits (CPU time, address space,
+file size, no core files), its own process group (ended as a whole, from outside); a cap on
+processes where the cgroup v1 `pids` controller is writable, else RLIMIT_NPROC (not for root).
+`Sandbox.verify()` runs a probe inside and `report()` states only what the probe saw hold.
 """
 import dataclasses
+import json
 import os
 import secrets
 import shutil
 import signal
+import socket
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
+from . import bwrap as _bwrap
+from .bwrap import SandboxUnavailable
+
+__all__ = ["Limits", "Process", "Sandbox", "SandboxUnavailable", "refusal"]
+
 LAUNCH = Path(__file__).with_name("_launch.py")
+PROBE = Path(__file__).with_name("probe.py")
 CGROUP_PIDS = Path("/sys/fs/cgroup/pids")
+# BLAS/LAPACK kernel and thread settings: the student's process must compute with the same
+# kernels as the grader's (another OpenBLAS kernel changes the last bits of an SVD)
+PASSED_THROUGH = ("OPENBLAS_CORETYPE", "OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS",
+                  "OMP_NUM_THREADS", "MKL_NUM_THREADS", "MKL_CBWR", "MKL_ENABLE_INSTRUCTIONS",
+                  "MKL_DEBUG_CPU_TYPE", "NPY_DISABLE_CPU_FEATURES")
+INSTALL_HINT = ("install bubblewrap (Debian/Ubuntu: sudo apt-get install bubblewrap; Fedora: "
+                "sudo dnf install bubblewrap; Arch: sudo pacman -S bubblewrap); on macOS or "
+                "Windows grade inside a Linux VM or container that has it (README, Grading)")
+OVERRIDE = "--no-sandbox"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -30,15 +50,6 @@ class Limits:
     memory_mb: int = 4096
     processes: int = 256
     file_mb: int = 256
-
-
-def _bwrap_works(bwrap):
-    try:
-        return subprocess.run([bwrap, "--ro-bind", "/", "/", "--dev", "/dev", "--proc", "/proc",
-                               "--unshare-net", "--unshare-pid", "--die-with-parent", "true"],
-                              capture_output=True, timeout=20).returncode == 0
-    except (OSError, subprocess.SubprocessError):
-        return False
 
 
 def _cgroup_works():
@@ -52,27 +63,92 @@ def _cgroup_works():
         return False
 
 
-class Sandbox:
-    """How student processes are started; `hidden`: folders they must not see."""
+def refusal(tried):
+    return ("no sandbox for the students' code on this machine, so nothing was graded.\n"
+            + "".join(f"  tried: {line}\n" for line in tried)
+            + f"  to fix: {INSTALL_HINT}.\n"
+            f"  to grade anyway, WITHOUT isolation (every student's code then runs with your "
+            f"rights: it can read and change your files and use the network), pass {OVERRIDE}.")
 
-    def __init__(self, hidden=(), limits=Limits(), bwrap=None):
+
+class Sandbox:
+    """How student processes are started. `hidden`: folders they must not see; `bwrap`: a path,
+    False (do not use it) or None (find it); `unsandboxed`: run without isolation (the override).
+    Raises SandboxUnavailable when no backend works and `unsandboxed` is false."""
+
+    def __init__(self, hidden=(), limits=Limits(), bwrap=None, unsandboxed=False):
         self.limits = limits
         self.work_root = Path(tempfile.mkdtemp(prefix="ikteach-grade-")).resolve()
-        needed = [Path(__file__).resolve().parents[2], Path(sys.prefix).resolve(),
-                  Path(sys.base_prefix).resolve(),
-                  Path(sys.executable).resolve()]  # ikteach and the Python it runs on
-        self.needed = needed
-        wanted = [Path(p).resolve() for p in hidden if p and Path(p).exists()]
-        self.hidden = [p for p in wanted if not any(p == n or p in n.parents for n in needed)]
-        self.unhidden = [p for p in wanted if p not in self.hidden]
-        self.hidden.append(self.work_root)  # every run's folder; each run sees only its own
-        path = shutil.which("bwrap") if bwrap is None else (bwrap or None)
-        self.bwrap = path if path and _bwrap_works(path) else None
+        self.package = Path(__file__).resolve().parents[2]  # ikteach/
+        self.hidden = [Path(p).resolve() for p in hidden if p and os.path.lexists(p)]
+        self.hidden += [self.package / "course" / "check", self.work_root]  # the checker too
         self.cgroup = _cgroup_works()
         self.root = os.geteuid() == 0
+        self.tried, self.verified, self.flags = [], [], None
+        self.bwrap = None
+        path = shutil.which("bwrap") if bwrap is None else (bwrap or None)
+        if bwrap is False:
+            self.tried.append("bubblewrap: not used (told not to)")
+        elif not path:
+            self.tried.append("bubblewrap: `bwrap` not found on PATH")
+        else:
+            self.flags, why = _bwrap.working_flags(path)
+            if self.flags is None:
+                self.tried.append(f"bubblewrap ({path}): {why}")
+            else:
+                self.bwrap = path
+        self.unsandboxed = self.bwrap is None and bool(unsandboxed)
+        if self.bwrap is None and not unsandboxed:
+            self.close()
+            raise SandboxUnavailable(refusal(self.tried))
+
+    @property
+    def backend(self):
+        return "bubblewrap" if self.bwrap else f"none ({OVERRIDE})"
 
     def close(self):
         shutil.rmtree(self.work_root, ignore_errors=True)
+
+    def verify(self):
+        """Run the probe in the sandbox; what it saw hold becomes report()'s lines. Raises
+        SandboxUnavailable when bubblewrap runs but does not isolate, or when the grader's own
+        Python or ikteach cannot run in the sandbox."""
+        work = Path(tempfile.mkdtemp(prefix="probe-", dir=self.work_root))
+        server = socket.socket()
+        server.bind(("127.0.0.1", 0))
+        server.listen()
+        token = secrets.token_hex(6)
+        outside = sorted({str(self.package), sys.prefix, os.getcwd(), str(Path.home()),
+                          tempfile.gettempdir()} | {str(p.parent) for p in self.hidden})
+        request = {"token": token, "writes": outside, "reads": [str(p) for p in self.hidden],
+                   "port": server.getsockname()[1], "imports_only": not self.bwrap}
+        try:
+            process = self.start([sys.executable, str(PROBE), json.dumps(request)], work,
+                                 stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                 stderr=subprocess.STDOUT)
+            try:
+                out = process.proc.communicate(timeout=120)[0].decode(errors="replace")
+            except subprocess.TimeoutExpired:
+                out = "(no answer within 120 s)"
+            finally:
+                process.end()
+        finally:
+            server.close()
+        marker = f".ikteach-probe-{token}"
+        escaped = [d for d in outside if os.path.lexists(os.path.join(d, marker))]
+        for d in escaped:
+            os.unlink(os.path.join(d, marker))
+        try:
+            seen = json.loads(out.strip().splitlines()[-1])
+        except (ValueError, IndexError):
+            raise SandboxUnavailable(f"the sandbox self-check could not run Python "
+                                     f"({sys.executable}) in the sandbox: {out[-600:]}") from None
+        if seen.get("import_error"):
+            raise SandboxUnavailable("the grader's Python or packages do not work in the sandbox: "
+                                     f"{seen['import_error']}")
+        if self.bwrap:
+            self.verified = _bwrap.judge(seen, escaped, self.hidden)
+        return self.verified
 
     def report(self):
         """(enforced, not enforced): lists of short lines for the grader's log."""
@@ -81,7 +157,8 @@ class Sandbox:
                f"CPU time {lim.cpu_seconds} s per process (RLIMIT_CPU)",
                f"memory {lim.memory_mb} MiB address space per process (RLIMIT_AS)",
                f"file size {lim.file_mb} MiB (RLIMIT_FSIZE), no core files",
-               "wall-clock time limit; the process group is ended as a whole"]
+               "wall-clock time limits, applied from outside; the process group is killed "
+               "as a whole"]
         no = []
         if self.cgroup:
             yes.append(f"processes: at most {lim.processes} (cgroup pids.max)")
@@ -91,24 +168,16 @@ class Sandbox:
             no.append("process count (root ignores RLIMIT_NPROC and the pids cgroup is not "
                       "writable): a fork storm is bounded only by the CPU and time limits")
         if self.bwrap:
-            yes += ["no network (bubblewrap: own network namespace)",
-                    "no writes outside the working folder (bubblewrap: read-only root, "
-                    "private /tmp)",
-                    "solutions, submissions and grader output hidden (bubblewrap: empty "
-                    "tmpfs over " + ", ".join(str(p) for p in self.hidden) + ")"
-                    if self.hidden else "nothing to hide was given",
-                    "own PID namespace: every process it starts ends with it"]
+            yes += [f"{line} (checked at start-up)" for line in self.verified]
+            yes.append("visible, read-only, by its mount list (probed only as above): the "
+                       "system libraries, the grader's Python, ikteach's package without its "
+                       "checker; nothing else of this machine")
+            no.append("a kernel exploit (bubblewrap shares this machine's kernel)")
         else:
-            no += ["network (install bubblewrap: apt-get install bubblewrap)",
-                   "writes outside the working folder: only file permissions stop them",
-                   "reading the solutions and other students' folders: only file "
-                   "permissions stop it",
+            no += [f"ISOLATION: NONE ({OVERRIDE}): students' code runs with this user's rights",
+                   "network access, writes wherever this user may write, reading the solutions "
+                   "and other students' files",
                    "processes that leave the process group (setsid) may outlive the run"]
-        for path in self.unhidden:
-            no.append(f"hiding {path}: it holds the Python or ikteach the checks run on "
-                      "(put submissions and output elsewhere)")
-        no.append("reading files the grader's user may read outside the hidden folders "
-                  "(e.g. the installed packages) - run the grader in a container for more")
         return yes, no
 
     def _cgroup_dir(self):
@@ -128,28 +197,18 @@ class Sandbox:
                   str(cgroup) if cgroup else "-", "--"]
         if not self.bwrap:
             return launch + list(argv)
-        wrap = [self.bwrap, "--ro-bind", "/", "/", "--dev", "/dev", "--proc", "/proc",
-                "--tmpfs", "/tmp", "--tmpfs", "/dev/shm"]
-        tmp = Path("/tmp")
-        kept = [p for p in self.needed if tmp in p.parents]  # a checkout or venv under /tmp
-        kept = [p for p in kept if not any(q in p.parents for q in kept)]
-        for path in kept:
-            wrap += ["--ro-bind", str(path), str(path)]
-        for path in self.hidden:  # under /tmp only what was bound back needs hiding again
-            if tmp not in path.parents or any(k in path.parents for k in kept):
-                wrap += ["--tmpfs", str(path)]
-        wrap += ["--bind", str(work), str(work), "--chdir", str(work),
-                 "--unshare-net", "--unshare-pid", "--unshare-ipc", "--unshare-uts",
-                 "--die-with-parent", "--new-session", "--"]
-        return launch + wrap + list(argv)
+        return launch + _bwrap.command(self.bwrap, self.flags, self.package, self.hidden,
+                                       Path(work)) + list(argv)
 
     def environment(self, work):
         home = Path(work) / "home"
         (home / "tmp").mkdir(parents=True, exist_ok=True)
-        return {"PATH": f"{Path(sys.executable).parent}:/usr/local/bin:/usr/bin:/bin",
-                "HOME": str(home), "TMPDIR": str(home / "tmp"), "LANG": "C.UTF-8",
-                "MPLBACKEND": "Agg", "JAX_PLATFORMS": "cpu", "PYTHONDONTWRITEBYTECODE": "1",
-                "PYTHONNOUSERSITE": "1"}
+        env = {"PATH": f"{Path(sys.executable).parent}:/usr/local/bin:/usr/bin:/bin",
+               "HOME": str(home), "TMPDIR": str(home / "tmp"), "LANG": "C.UTF-8",
+               "MPLBACKEND": "Agg", "JAX_PLATFORMS": "cpu", "PYTHONDONTWRITEBYTECODE": "1",
+               "PYTHONNOUSERSITE": "1", "PYTHONPATH": str(self.package.parent)}
+        env.update({k: os.environ[k] for k in PASSED_THROUGH if k in os.environ})
+        return env
 
     def start(self, argv, work, **popen):
         """A running Process for argv in `work` (a folder the caller created)."""
@@ -180,7 +239,10 @@ class Process:
             pass
         if self.cgroup:
             for _ in range(50):
-                pids = (self.cgroup / "cgroup.procs").read_text().split()
+                try:
+                    pids = (self.cgroup / "cgroup.procs").read_text().split()
+                except OSError:
+                    break
                 if not pids:
                     break
                 for pid in pids:

@@ -1,0 +1,99 @@
+"""The sandbox's start-up probe: run inside it as a script (like a student's code), it tries
+what a student's code must not be able to do and prints one JSON line of what it saw.
+
+    python probe.py '{"token": ..., "writes": [folders], "reads": [hidden folders], "port": N,
+                      "imports_only": false}'
+
+The grader checks the writes on its own side too (a write into a private /tmp succeeds in
+here and escapes nowhere) and decides from this what its log may state (bwrap.judge).
+"""
+import ctypes
+import ctypes.util
+import json
+import os
+import socket
+import sys
+
+MS_REMOUNT, MS_BIND, CLONE_NEWUSER = 32, 4096, 0x10000000
+
+
+def capabilities():
+    bits = 0
+    with open("/proc/self/status") as status:
+        for line in status:
+            if line.split(":")[0] in ("CapInh", "CapPrm", "CapEff", "CapBnd", "CapAmb"):
+                bits |= int(line.split()[1], 16)
+    return bits
+
+
+def wrote(folders, token):
+    done = []
+    for folder in folders:
+        try:
+            os.close(os.open(os.path.join(folder, f".ikteach-probe-{token}"),
+                             os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o600))
+            done.append(folder)
+        except OSError:
+            pass
+    return done
+
+
+def readable(folders):
+    """Hidden folders whose content shows (beyond the way down to this run's own folder)."""
+    here, seen = os.getcwd(), []
+    for folder in folders:
+        try:
+            names = set(os.listdir(folder))
+        except OSError:
+            continue
+        if here.startswith(folder.rstrip("/") + "/"):
+            names.discard(here[len(folder.rstrip("/")) + 1:].split("/")[0])
+        if names:
+            seen.append(folder)
+    return seen
+
+
+def connected(port):
+    try:
+        socket.create_connection(("127.0.0.1", port), timeout=2).close()
+        return True
+    except OSError:
+        return False
+
+
+def mounted(libc, package):
+    os.makedirs("mnt", exist_ok=True)
+    tmpfs = libc.mount(b"none", b"mnt", b"tmpfs", 0, None) == 0
+    remount = libc.mount(None, package.encode(), None, MS_REMOUNT | MS_BIND, None) == 0
+    return tmpfs or remount
+
+
+def userns_blocked(libc):
+    pid = os.fork()
+    if pid == 0:  # in a child: a new user namespace would change this process for good
+        os._exit(0 if libc.unshare(CLONE_NEWUSER) == 0 else 1)
+    return os.waitpid(pid, 0)[1] != 0
+
+
+def main(request):
+    libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+    package = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    seen = {}
+    if not request.get("imports_only"):  # unsandboxed (the override): try nothing harmful
+        seen = {"uid": os.getuid(), "capabilities": capabilities(),
+                "wrote": wrote(request["writes"], request["token"]),
+                "read": readable(request["reads"]), "connected": connected(request["port"]),
+                "mounted": mounted(libc, package), "userns_blocked": userns_blocked(libc),
+                "processes": sum(name.isdigit() for name in os.listdir("/proc"))}
+    try:
+        import ikteach  # noqa: F401 - what the checks' worker and the runner need
+        import ipykernel  # noqa: F401
+        import nbclient  # noqa: F401
+        seen["import_error"] = None
+    except BaseException as exc:  # noqa: B036 - reported to the grader
+        seen["import_error"] = f"{type(exc).__name__}: {exc}"[:500]
+    print(json.dumps(seen))
+
+
+if __name__ == "__main__":
+    main(json.loads(sys.argv[1]))
