@@ -17,7 +17,7 @@ from .limits import cap_step
 from .pinv import DEFAULT_RCOND
 from .sdls import GAMMA_MAX
 from .levels import DEFAULT_REST_GAIN
-from .solve import DEFAULT_DAMPING, Settings, linearize, resolve_method, with_extras
+from .solve import Settings, default_damping, linearize, resolve_method, with_extras
 from .tasks import task_for
 from .._runtime import jit as runtime_jit
 
@@ -82,12 +82,13 @@ def _track_chunks(method, task, arm, targets, theta0, settings, d_max):
     return np.concatenate(thetas)[: steps + 1], np.concatenate(errors)[:steps]
 
 
-def track(arm, targets, theta0=None, method="dls", damping=DEFAULT_DAMPING, rcond=DEFAULT_RCOND,
+def track(arm, targets, theta0=None, method="dls", damping=None, rcond=DEFAULT_RCOND,
           clamp=None, max_step=None, gamma_max=GAMMA_MAX, joint_limits=None, limit_mode=None,
           levels=None, rest_pose=None, rest_gain=DEFAULT_REST_GAIN):
     """Follow targets[0], targets[1], ... with one step of `method` each (Buss's protocol).
 
     targets  (T, *target shape): one target (or one per end effector) per time step.
+    damping  DLS's lambda (default L / 6, as in ik.solve).
     clamp    D_max: each end effector's error is clamped to at most D_max before the step.
     max_step cap on any joint's change per step (radians).
     joint_limits, limit_mode, levels, rest_pose, rest_gain: as in ik.solve.
@@ -99,7 +100,8 @@ def track(arm, targets, theta0=None, method="dls", damping=DEFAULT_DAMPING, rcon
     task = task_for(arm, targets.shape[1:], "targets")
     theta0 = np.zeros(arm.n_joints) if theta0 is None else as_array(theta0, "theta0", shape=(arm.n_joints,))
     settings = Settings(
-        tol=0.0, damping=as_number(damping, "damping", minimum=0),
+        tol=0.0, damping=as_number(default_damping(task, arm) if damping is None else damping,
+                                   "damping", minimum=0),
         rcond=as_number(rcond, "rcond", minimum=0), clamp=np.inf,
         max_step=np.inf if max_step is None else as_number(max_step, "max_step", minimum=0, strict=True),
         stall_tol=0.0, gamma_max=as_number(gamma_max, "gamma_max", minimum=0, strict=True))
