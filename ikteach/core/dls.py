@@ -5,7 +5,7 @@ import jax.numpy as jnp
 from .small_solve import solve_small
 
 WELL_POSED = 1e-10  # det(A) / prod(diag A) above this: the m x m solve is far above rounding
-FLOOR = 1e-6        # else lambda^2 is raised by FLOOR * trace(J J^T) / m, just for that step
+FLOOR = 1e-6        # lambda^2 below FLOOR * trace(J J^T) / m on an ill-posed A: raised by that
 
 
 def well_posed(A):
@@ -34,15 +34,16 @@ def dls_step(J, e, damping):
 
     Equal to dls_step_normal by (J^T J + lambda^2 I)^-1 J^T = J^T (J J^T + lambda^2 I)^-1,
     and cheaper when n >> m. solve_small: closed form for m <= 3, LU above.
-    With lambda = 0 (or tiny) at a singular J the system is singular: then, and only then,
-    lambda^2 + FLOOR trace(J J^T) / m is used, so the step stays finite (no change elsewhere).
+    With lambda = 0 (or tiny) at a singular J the system is singular: then, and only then
+    (lambda^2 < FLOOR trace(J J^T) / m and det(A) lost in rounding), lambda^2 is raised by
+    FLOOR trace(J J^T) / m, so the step stays finite; every other step is the plain formula.
     """
     J, e = jnp.asarray(J), jnp.asarray(e)
     m = J.shape[0]
     G = J @ J.T
     A = G + damping**2 * jnp.eye(m)
-    floored = A + FLOOR * jnp.trace(G) / m * jnp.eye(m)
-    A = jnp.where(well_posed(A), A, floored)
+    floor = FLOOR * jnp.trace(G) / m
+    A = jnp.where((damping**2 < floor) & ~well_posed(A), A + floor * jnp.eye(m), A)
     return J.T @ solve_small(A, e)
 
 
