@@ -16,15 +16,8 @@ TREES = {"y": (bt.y_tree, bt.y_targets), "double_y": (bt.double_y_tree, bt.doubl
 
 
 def methods(tree_name):
-    """Buss's settings per method (Jacobian.cpp of his demo)."""
-    return {
-        "JT": dict(method="jt", max_step=bt.MAX_STEP["jt"]),
-        "pseudoinverse": dict(method="pinv", max_step=bt.MAX_STEP["pinv"], rcond=bt.PINV_RCOND),
-        "DLS": dict(method="dls", max_step=bt.MAX_STEP["dls"], damping=bt.DAMPING[tree_name]),
-        "DLS + clamp": dict(method="dls", max_step=bt.MAX_STEP["dls"], damping=bt.DAMPING["clamped"],
-                            clamp=bt.D_MAX),
-        "SDLS": dict(method="sdls", clamp=bt.D_MAX),
-    }
+    """Buss's settings per method (Jacobian.cpp of his demo): ikteach/core/buss_trees.py."""
+    return bt.demo_methods(tree_name)
 
 
 def run(tree_name, steps, warmup, **kw):

@@ -27,7 +27,8 @@ def test_batch_takes_one_start_per_target_and_counts_statuses():
     res = ik.solve_batch(ARM, targets, starts, clamp=0.3)
     assert len(res) == 2
     assert list(res.status) == ["converged", "stalled"]
-    assert res.counts() == {"converged": 1, "stalled": 1, "max_iter": 0, "diverged": 0, "slow": 0}
+    assert res.counts() == {"converged": 1, "stalled": 1, "max_iter": 0, "diverged": 0, "slow": 0,
+                            "singular": 0, "damped": 0}
 
 
 def test_batch_accepts_a_jax_step_function():

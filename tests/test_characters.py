@@ -119,4 +119,5 @@ def test_feet_first_priorities_keep_the_feet_when_the_hand_cannot_reach(clip):
         p = skeleton.world_points(rig, root, res.theta)[0]
         slid[name] = np.linalg.norm(p[:4] - start[:4], axis=1).max()
         assert np.linalg.norm(p[4] - far[4]) < np.linalg.norm(start[4] - far[4]) - 20  # reached out
-    assert slid["stacked"] > 0.1 and slid["feet first"] < 1e-3
+    # run to its stall (the motion rule), stacked DLS gives the feet only a little: 0.004 cm here
+    assert slid["stacked"] > 1e-3 and slid["feet first"] < 1e-6

@@ -133,9 +133,10 @@ def test_new_pose_weights_compile_nothing_new():
     """PoseTask's weights are traced data: a new (position, orientation) pair reuses the loop."""
     ur5 = ik.ur5()
     target = np.asarray(ik.fk_pose(ur5, np.full(6, 0.4)))
-    first = ik.solve(ur5, target, np.zeros(6), weights=(1.0, 0.5))
+    kw = dict(tol=1e-3, damping=0.5)  # absolute: the defaults scale with the UR5's reach (1.19)
+    first = ik.solve(ur5, target, np.zeros(6), weights=(1.0, 0.5), **kw)
     before = len(COMPILES)
-    results = [ik.solve(ur5, target, np.zeros(6), weights=w) for w in [(1.0, 0.3), (2.0, 1.0), (0.7, 0.1)]]
+    results = [ik.solve(ur5, target, np.zeros(6), weights=w, **kw) for w in [(1.0, 0.3), (2.0, 1.0), (0.7, 0.1)]]
     assert len(COMPILES) == before, COMPILES[before:]
     assert len({r.iterations for r in [first, *results]}) > 1  # the weights did matter
     assert all(r.status == "converged" for r in results)

@@ -26,8 +26,9 @@ import numpy as np
 from .pinv import DEFAULT_RCOND
 from .sdls import GAMMA_MAX
 from .methods import require_traceable
-from .solve import (DEFAULT_DAMPING, RUNNING, STATUSES, _run_jit, advance, check_problem,
+from .solve import (RUNNING, STATUSES, _run_jit, advance, check_problem, explain_stalls,
                     initial_state, resolve_method, run_chunks, status_counts, with_extras)
+from .stop_rules import DEFAULT_STOP_RULE
 from .._runtime import jit as runtime_jit
 
 SLOTS = 1024  # targets in flight at once (per device)
@@ -161,23 +162,23 @@ def _one_by_one(method, task, arm, targets, thetas0, settings, max_iter):
     return jax.tree_util.tree_map(lambda *rows: np.stack([np.asarray(r) for r in rows]), *states)
 
 
-def solve_batch(arm, targets, theta0, method="dls", tol=1e-3, max_iter=1000,
-                damping=DEFAULT_DAMPING, rcond=DEFAULT_RCOND, clamp=None, max_step=None,
-                stall_tol=None, gamma_max=GAMMA_MAX, weights=None, stop_rule="joint_steps",
+def solve_batch(arm, targets, theta0, method="dls", tol=None, max_iter=1000,
+                damping=None, rcond=DEFAULT_RCOND, clamp=None, max_step=None,
+                stall_tol=None, gamma_max=GAMMA_MAX, weights=None, stop_rule=DEFAULT_STOP_RULE,
                 joint_limits=None, limit_mode=None, levels=None, rest_pose=None,
                 rest_gain=None):
     """Solve for every row of targets (B, d); theta0 is one start (n,) or one per target (B, n).
 
     A spatial chain takes 4x4 pose targets too: targets (B, 4, 4), with weights as in ik.solve.
-    Same loop and stop rules as ik.solve (no trace is kept); method must be a name or a
-    step function written with jax.numpy. Every row ends where ik.solve ends from the same
-    start, to the bit (tests/test_batch.py: every method on planar, spatial and pose targets,
-    trees, priority levels and joint limits, batches of 12). The queue's arithmetic is
-    vectorised over its slots; at several hundred slots XLA may vectorise some sums of pose and
-    tree tasks differently, and their last bits can then differ (seen: 2e-15 rad for SDLS on
-    UR5 poses, 1,100 targets; a JT run to max_iter amplifies it). stop_rule, joint_limits, limit_mode, levels,
-    rest_pose and rest_gain as in ik.solve. Bad input raises a ValueError as in ik.solve;
-    an empty batch (no rows) too.
+    Same loop, defaults, stop rules and statuses as ik.solve (no trace is kept); method must
+    be a name or a step function written with jax.numpy. Every row ends where ik.solve ends
+    from the same start, to the bit (tests/test_batch.py: every method on planar, spatial and
+    pose targets, trees, priority levels and joint limits, batches of 12). The queue's
+    arithmetic is vectorised over its slots; at several hundred slots XLA may vectorise some
+    sums of pose and tree tasks differently, and their last bits can then differ (seen: 2e-15
+    rad for SDLS on UR5 poses, 1,100 targets; a JT run to max_iter amplifies it). stop_rule,
+    joint_limits, limit_mode, levels, rest_pose and rest_gain as in ik.solve. Bad input raises
+    a ValueError as in ik.solve; an empty batch (no rows) too.
     """
     method = resolve_method(method)
     task, targets, theta0, settings, max_iter = check_problem(
@@ -190,9 +191,10 @@ def solve_batch(arm, targets, theta0, method="dls", tol=1e-3, max_iter=1000,
     if theta0.ndim == 1:
         theta0 = jnp.broadcast_to(theta0, (targets.shape[0], theta0.shape[0]))
     state = _run(method, task, arm, targets, theta0, settings, max_iter)
+    status = explain_stalls(method, task, arm, targets, state.theta, state.status, settings)
     return BatchResult(
         theta=np.asarray(state.theta),
-        status=np.asarray(STATUSES, dtype=object)[np.asarray(state.status)],
+        status=np.asarray(STATUSES, dtype=object)[status],
         iterations=np.asarray(state.i),
         error=np.asarray(state.error),
     )

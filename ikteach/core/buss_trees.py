@@ -5,21 +5,56 @@ least squares for inverse kinematics"; demo program main file: BuildTreeYShape,
 BuildTreeDoubleYShape, UpdateTargets; Jacobian.cpp for the method constants). Positions are
 world positions in the rest pose; the demo's node order gives our joint and effector order.
 The targets are sums of sines of the time T, updated once per time step T_STEP.
+
+The method settings are the constants of Buss's Jacobian.cpp as shipped in bullet3
+(examples/ThirdPartyLibs/BussIK): demo_methods(tree_name) gives them to ik.track. What is ours
+and not his is said there.
 """
 import numpy as np
 
+from .sdls import GAMMA_MAX, sdls_step
 from .tree import tree
 
 T_STEP = 0.005        # Tstep = 0.0005 * SlowdownFactor (10) in the demo
 UNIT1 = np.array([np.sqrt(14.0) / 8.0, 1.0 / 8.0, 7.0 / 8.0])   # the demo's "unit1" axis
 X, Y, Z = np.eye(3)
 
-# The demo's per-method settings (Jacobian.cpp): JT, pseudoinverse and DLS joint caps,
-# the pseudoinverse cut-off, DLS damping for each tree and with clamping, and D_max.
-MAX_STEP = {"jt": np.radians(30.0), "pinv": np.radians(5.0), "dls": np.radians(30.0)}
+# The demo's per-method settings (Jacobian.cpp): MaxAngleJtranspose, MaxAnglePseudoinverse,
+# MaxAngleDLS (MaxAngleSDLS = 45 degrees = GAMMA_MAX), PseudoInverseThresholdFactor,
+# DefaultDampingLambda (0.6 "optimal for the Y"; the two commented-out alternatives: 1.1 for the
+# double Y, 0.7 for the double Y with distance clamping) and BaseMaxTargetDist.
+MAX_STEP = {"jt": np.radians(30.0), "pinv": np.radians(5.0), "dls": np.radians(45.0)}
 PINV_RCOND = 0.01
-DAMPING = {"y": 0.6, "double_y": 0.5, "clamped": 0.7}
+DAMPING = {"y": 0.6, "double_y": 1.1, "clamped": 0.7}
 D_MAX = 0.4           # BaseMaxTargetDist
+
+
+def sdls_demo(J, e):
+    """Buss's demo SDLS (CalcDeltaThetasSDLS): soft rescales (ikteach/sdls.py, soft=True),
+    gamma_max 45 degrees, 3 rows per end effector. A step function for ik.track."""
+    return sdls_step(J, e, GAMMA_MAX, block=3, soft=True)
+
+
+def demo_methods(tree_name):
+    """ik.track's settings for each method of Buss's demo on "y" or "double_y".
+
+    Everything is his, except: DLS + clamp on the Y uses the Y's 0.6 (his 0.7 is stated for the
+    double Y only), and the growing clamp reads each effector's own previous distance (his
+    UpdatedSClampValue reads entries i..i+2 of the stacked error for effector i, which are
+    effector i's own only for i = 0). DLS + clamp is his optional variant: its lines are
+    commented out in Jacobian.cpp. The course's own SDLS (method="sdls", the paper's hard
+    ClampMaxAbs and a fixed clamp) is listed too, as "SDLS (paper)".
+    """
+    clamped = DAMPING["clamped"] if tree_name == "double_y" else DAMPING["y"]
+    grow = dict(clamp=D_MAX, clamp_growth=True)
+    return {
+        "JT": dict(method="jt", max_step=MAX_STEP["jt"]),
+        "pseudoinverse": dict(method="pinv", max_step=MAX_STEP["pinv"], rcond=PINV_RCOND),
+        "DLS": dict(method="dls", max_step=MAX_STEP["dls"], damping=DAMPING[tree_name]),
+        "DLS + clamp": dict(method="dls", max_step=MAX_STEP["dls"], damping=clamped, **grow),
+        "SDLS": dict(method=sdls_demo, **grow),
+        "SDLS (paper)": dict(method="sdls", clamp=D_MAX),
+    }
 
 
 def y_tree():

@@ -9,6 +9,7 @@ import jax
 import jax.numpy as jnp
 
 from .ccd import CCDMethod
+from .chain import Chain
 from .dls import dls_step
 from .fabrik import FABRIKMethod
 from .joint_limits import LimitedMethod
@@ -135,3 +136,12 @@ def resolve_method(method):
         return JacobianMethod(UserStep(method))
     raise ValueError(f"method: expected one of {sorted(METHODS)} or a function "
                      f"step(J, e) -> delta_theta, got {method!r:.80}")
+
+
+def check_method_target(method, task, arm, name="target"):
+    """CCD and FABRIK move the end effector towards a point: position targets on chains only."""
+    kind = {CCDMethod: "ccd", FABRIKMethod: "fabrik"}.get(type(method))
+    if kind is None or not isinstance(arm, Chain) or type(task).__name__ == "PositionTask":
+        return  # (trees: the method's own check, ccd.require_chain, names them)
+    raise ValueError(f"method: {kind!r} works on chains with position targets ({name} of shape "
+                     f"({arm.dim},)), got a 4x4 pose target; use 'jt', 'pinv', 'dls' or 'sdls'")

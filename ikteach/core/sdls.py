@@ -13,6 +13,11 @@ joints turned as 1/sigma_i v_i asks (M_i):
 
 ClampMaxAbs(w, d) scales w down so that max_l |w_l| <= d (ik.cap_step). The paper uses
 gamma_max = pi/4; so no joint ever turns by more than gamma_max in one step.
+
+Buss's own demo code (Jacobian.cpp, CalcDeltaThetasSDLS) rescales softly instead, and that
+is what soft=True does: each direction's term w is added as w gamma_i / (gamma_i + max|w|)
+(always, not only when max|w| > gamma_i), and a sum with max|.| = c > gamma_max is scaled by
+gamma_max / (gamma_max + c) (so its largest turn is below gamma_max, not equal to it).
 """
 import dataclasses
 import functools
@@ -43,11 +48,17 @@ def sdls_gamma(U, sigma, Vt, J, gamma_max, block):
     return gamma_max * jnp.minimum(1.0, ratio)
 
 
-@functools.partial(jax.jit, static_argnames="block")
-def sdls_step(J, e, gamma_max=GAMMA_MAX, block=None):
+def soft_rescale(w, gamma):
+    """Buss's demo code: w gamma / (gamma + max_l |w_l|)."""
+    return w * (gamma / (gamma + jnp.max(jnp.abs(w))))
+
+
+@functools.partial(jax.jit, static_argnames=("block", "soft"))
+def sdls_step(J, e, gamma_max=GAMMA_MAX, block=None, soft=False):
     """delta_theta = ClampMaxAbs(sum_i ClampMaxAbs((u_i.e / sigma_i) v_i, gamma_i), gamma_max).
 
     J has one block of `block` rows per end effector (default: all rows, one effector).
+    soft=True: Buss's demo code's soft rescales in place of both ClampMaxAbs (module doc).
     """
     J, e = jnp.asarray(J), jnp.asarray(e)
     block = J.shape[0] if block is None else block
@@ -55,6 +66,10 @@ def sdls_step(J, e, gamma_max=GAMMA_MAX, block=None):
     gamma = sdls_gamma(U, sigma, Vt, J, gamma_max, block)
     keep = sigma > NEAR_ZERO
     coeff = jnp.where(keep, (U.T @ e) / jnp.where(keep, sigma, 1.0), 0.0)
+    if soft:
+        total = jax.vmap(soft_rescale)(coeff[:, None] * Vt, gamma).sum(axis=0)
+        largest = jnp.max(jnp.abs(total))
+        return jnp.where(largest > gamma_max, total * (gamma_max / (gamma_max + largest)), total)
     phi = jax.vmap(cap_step)(coeff[:, None] * Vt, gamma)          # one row per direction
     return cap_step(phi.sum(axis=0), gamma_max)
 

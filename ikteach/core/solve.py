@@ -5,10 +5,12 @@ Each iteration, at the current theta:
   2. stop "converged" if ||e|| < tol (checked before any step is taken);
   3. stop "stalled" if the last step was smaller than stall_tol (out of reach), or "slow" if
      so but ||e|| still fell by a steady fraction (see stop_rules.py: the size is
-     sum |delta_theta_i| by default, ||J delta_theta|| with stop_rule="motion");
+     ||J delta_theta|| by default, sum |delta_theta_i| with stop_rule="joint_steps");
   4. stop "max_iter" after max_iter steps;
   5. otherwise delta_theta = cap(step(J, clamp(e))); a non-finite step stops "diverged"
      and keeps the last finite theta.
+After the loop, a "stalled" solve is looked at where it stopped (stop_rules.stall_kind):
+a saddle of ||e|| becomes "singular", a stop while J still sees the error "damped".
 """
 import dataclasses
 from functools import partial
@@ -19,24 +21,39 @@ import jax.numpy as jnp
 import numpy as np
 
 from ._validate import as_array, as_count, as_number
-from .ccd import CCDMethod
-from .chain import Chain
-from .fabrik import FABRIKMethod
 from .sdls import GAMMA_MAX
 from .levels import with_priorities
 from .joint_limits import with_limits
 from .limits import cap_step
-from .methods import METHODS, resolve_method, traceable
+from .methods import METHODS, check_method_target, resolve_method, traceable
 from .pinv import DEFAULT_RCOND
 from .tasks import task_for
 from . import stop_rules
 from .._runtime import jit as runtime_jit
 
-STATUSES = ("running", "converged", "stalled", "max_iter", "diverged", "slow")  # append only
-RUNNING, CONVERGED, STALLED, MAX_ITER, DIVERGED, SLOW = range(6)
+# What each status means (the course's definitions; append only):
+#   converged  ||e|| < tol.
+#   stalled    the steps stopped moving the end effector at a minimum of ||e||: out of reach.
+#   max_iter   max_iter steps taken, none of the other stops fired (e.g. the pseudoinverse
+#              out of reach: it never settles).
+#   diverged   a non-finite error or step.
+#   slow       the stall rule fired, but ||e|| still fell by more than SLOW_PROGRESS per step:
+#              still closing in (e.g. the Jacobian transpose along a weak direction).
+#   singular   the stall rule fired at a saddle of ||e|| (a singular pose whose error J cannot
+#              see, e.g. a straight arm with the target on its line): not out of reach.
+#   damped     the stall rule fired while J still sees the error: the damping, max_step or
+#              clamp cut the steps to nothing for this arm's size. Not out of reach.
+STATUSES = ("running", "converged", "stalled", "max_iter", "diverged", "slow", "singular",
+            "damped")
+RUNNING, CONVERGED, STALLED, MAX_ITER, DIVERGED, SLOW, SINGULAR, DAMPED = range(8)
 
-DEFAULT_DAMPING = 0.5
-STALL_FRACTION = 1e-5  # default stall_tol = STALL_FRACTION * total link length
+# Defaults that are lengths scale with the arm's size L (task.length_scale: the total link
+# length of a chain, the size of a tree); for the course's arm of three unit links (L = 3)
+# they are tol = 1e-3 and lambda = 0.5.
+TOL_PER_LENGTH = 3000      # tol = L / 3000
+DAMPING_PER_LENGTH = 6     # damping lambda = L / 6
+STALL_PER_TOL = 0.01  # default stall_tol = tol / 100 (L / 300000 with the default tol)
+STALL_FRACTION = 1e-5  # the old default stall_tol / L (benchmarks/sweep.py's copies of the report's loop)
 
 
 class StopSolve(Exception):
@@ -64,7 +81,7 @@ class Settings(NamedTuple):
     upper: object = np.inf
     rest_pose: object = 0.0  # the rest-pose level of a prioritised solve (ikteach/levels.py)
     rest_gain: float = 0.0
-    stop_rule: int = 0  # index into stop_rules.STOP_RULES
+    stop_rule: int = stop_rules.STOP_RULES.index(stop_rules.DEFAULT_STOP_RULE)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -237,13 +254,14 @@ def with_extras(method, task, arm, target, theta0, settings, levels, rest_pose, 
     return with_limits(method, settings, theta0, joint_limits, limit_mode, arm.n_joints)
 
 
-def check_method_target(method, task, arm, name="target"):
-    """CCD and FABRIK move the end effector towards a point: position targets on chains only."""
-    kind = {CCDMethod: "ccd", FABRIKMethod: "fabrik"}.get(type(method))
-    if kind is None or not isinstance(arm, Chain) or type(task).__name__ == "PositionTask":
-        return  # (trees: the method's own check, ccd.require_chain, names them)
-    raise ValueError(f"method: {kind!r} works on chains with position targets ({name} of shape "
-                     f"({arm.dim},)), got a 4x4 pose target; use 'jt', 'pinv', 'dls' or 'sdls'")
+def default_tol(task, arm):
+    """tol when none is given: L / TOL_PER_LENGTH (1e-3 for three unit links)."""
+    return task.length_scale(arm) / TOL_PER_LENGTH
+
+
+def default_damping(task, arm):
+    """DLS's lambda when none is given: L / DAMPING_PER_LENGTH (0.5 for three unit links)."""
+    return task.length_scale(arm) / DAMPING_PER_LENGTH
 
 
 def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, max_step,
@@ -278,10 +296,12 @@ def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, 
     if max_iter > MAX_ITER_CAP:
         raise ValueError(f"max_iter: expected at most {MAX_ITER_CAP:,} iterations (ik.solve keeps "
                          f"every iterate), got {max_iter:,}")
-    if stall_tol is None:  # the default follows the arm's size (not checked as a user's number)
-        stall_tol = STALL_FRACTION * task.length_scale(arm)
+    tol = default_tol(task, arm) if tol is None else tol
+    if stall_tol is None:  # a step that moves the effector by less than tol / 100 does not matter
+        stall_tol = STALL_PER_TOL * as_number(tol, "tol")
     else:
         stall_tol = as_number(stall_tol, "stall_tol", minimum=0)
+    damping = default_damping(task, arm) if damping is None else damping
     settings = Settings(
         tol=as_number(tol, "tol", minimum=0, strict=True),
         damping=as_number(damping, "damping", minimum=0),
@@ -295,7 +315,16 @@ def check_problem(arm, target, theta0, *, tol, max_iter, damping, rcond, clamp, 
     return task, jnp.asarray(target), jnp.asarray(theta0), settings, max_iter
 
 
-def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DEFAULT_DAMPING,
+def explain_stalls(method, task, arm, targets, thetas, status, settings):
+    """status with each STALLED row looked at where it stopped (stop_rules.why_stalled):
+    a saddle of ||e|| becomes SINGULAR, a stop while J still sees the error DAMPED."""
+    status = np.array(status)
+    kinds = stop_rules.why_stalled(method, task, arm, targets, thetas, status == STALLED, settings)
+    return np.select([kinds == stop_rules.SADDLE, kinds == stop_rules.CUT_SHORT],
+                     [SINGULAR, DAMPED], status)
+
+
+def solve(arm, target, theta0, method="dls", tol=None, max_iter=1000, damping=None,
           rcond=DEFAULT_RCOND, clamp=None, max_step=None, stall_tol=None, gamma_max=GAMMA_MAX,
           weights=None, stop_rule=stop_rules.DEFAULT_STOP_RULE, joint_limits=None,
           limit_mode=None, levels=None, rest_pose=None, rest_gain=None):
@@ -303,17 +332,20 @@ def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DE
 
     method    "jt", "pinv", "dls", "sdls", "ccd", "fabrik", or a function step(J, e) -> delta_theta
               (it may raise ik.StopSolve to end the solve "stalled": its own stop rule).
-    tol       stop "converged" when ||e|| < tol.
+    tol       stop "converged" when ||e|| < tol (a length; default L / 3000, with L the arm's
+              total link length or a tree's size: 1e-3 for three unit links).
     max_iter  stop "max_iter" after this many steps (at most MAX_ITER_CAP; any value reuses the
               compiled loop, and the trace grows with the iterations taken, not with max_iter).
-    damping   lambda of DLS.   rcond: the pseudoinverse's relative cut-off.
+    damping   lambda of DLS (a length: default L / 6, 0.5 for three unit links).
+    rcond     the pseudoinverse's relative cut-off.
     clamp     Buss's D_max: |e| is clamped to at most D_max before each step.
     max_step  cap on any joint's change per step, in radians.
-    stall_tol stop "stalled" (or "slow": still converging) when the last step's size < stall_tol
-              (default STALL_FRACTION * total link length; 0 turns it off).
-    stop_rule the step's size: "joint_steps" (the report's sum |delta_theta_i|, radians: the
-              default, depends on the unit of length) or "motion" (||J delta_theta||, the
-              end effector's motion: scale-free, recommended). See ikteach/stop_rules.py.
+    stall_tol stop when the last step's size < stall_tol (default tol / 100; 0 turns it off):
+              "stalled" at a minimum of ||e|| (out of reach), "slow" if ||e|| still falls,
+              "singular" at a saddle, "damped" if J still sees the error (see STATUSES).
+    stop_rule the step's size: "motion" (||J delta_theta||, the end effector's motion:
+              scale-free, the default) or "joint_steps" (the report's sum |delta_theta_i|,
+              radians against a length: depends on the unit of length). See stop_rules.py.
     gamma_max SDLS's largest joint turn per step (default pi/4).
     weights   for a 4x4 pose target: (position_weight, orientation_weight), default (1, 1).
     joint_limits  (lower, upper): per-joint arrays (or numbers), +-inf for no limit; every
@@ -328,7 +360,8 @@ def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DE
               space of those before it (ikteach/levels.py).  rest_pose: a last level pulling
               theta towards rest_pose with gain rest_gain (default 0.1, levels.py's
               DEFAULT_REST_GAIN; only with rest_pose) in the freedom that is left.
-    Returns a Result: theta, status, iterations, error (final ||e||) and trace.
+    Returns a Result: theta, status, iterations, error (final ||e||) and trace. A start outside
+    joint_limits is moved onto them first.
 
     Bad input raises a ValueError naming the parameter: numbers must be real (no booleans,
     strings or complex), finite and of magnitude at most 1e40, positive sizes (tol, damping,
@@ -346,7 +379,9 @@ def solve(arm, target, theta0, method="dls", tol=1e-3, max_iter=1000, damping=DE
                                            rest_pose, rest_gain, joint_limits, limit_mode)
     run = _run_jit if traceable(method, task, arm, target, theta0, settings) else _run_eager
     state, thetas, errors = run_chunks(run, method, task, arm, target, theta0, settings, max_iter)
-    return Result(_frozen(state.theta), STATUSES[int(state.status)], int(state.i),
+    status = explain_stalls(method, task, arm, target[None], np.asarray(state.theta)[None],
+                            np.asarray(state.status)[None], settings)[0]
+    return Result(_frozen(state.theta), STATUSES[int(status)], int(state.i),
                   float(state.error), Trace(_frozen(thetas), _frozen(errors)))
 
 

@@ -17,7 +17,7 @@ from .limits import cap_step
 from .methods import require_traceable
 from .pinv import DEFAULT_RCOND
 from .sdls import GAMMA_MAX
-from .solve import (DEFAULT_DAMPING, Settings, check_method_target, linearize, resolve_method,
+from .solve import (Settings, check_method_target, default_damping, linearize, resolve_method,
                     with_extras)
 from .tasks import task_for
 from .._runtime import jit as runtime_jit
@@ -40,9 +40,11 @@ class TrackResult:
 
 
 def clamp_blocks(e, block, d_max):
-    """Clamp each effector's error |e_k| to at most D_max (Buss's per-effector clamp)."""
+    """Clamp each effector's error |e_k| to at most D_max (Buss's per-effector clamp; d_max a
+    number or one per effector)."""
     parts = e.reshape(-1, block)
     norm = jnp.linalg.norm(parts, axis=1, keepdims=True)
+    d_max = jnp.reshape(d_max, (-1, 1))
     scale = jnp.where(norm > d_max, d_max / jnp.where(norm > 0, norm, 1.0), 1.0)
     return (parts * scale).reshape(-1)
 
@@ -51,46 +53,57 @@ CHUNK = 128  # time steps per compiled scan: paths of any length reuse one progr
 
 
 @partial(runtime_jit.jit, static_argnames=("method",))
-def _track(method, task, arm, targets, theta0, settings, d_max):
-    """CHUNK (or fewer) steps; returns the last theta and every step's theta and error."""
+def _track(method, task, arm, targets, start, settings, d_max, grow):
+    """CHUNK (or fewer) steps from start = (theta, each effector's clamp); returns the last
+    (theta, clamps) and every step's theta and error."""
     block = getattr(task, "block_size", None)
 
-    def step(theta, target):
+    def step(carry, target):
+        theta, clamps = carry
         e, linearized = linearize(task, arm, target, theta)  # e and J from one walk
-        e = clamp_blocks(e, block or e.shape[0], d_max)
+        before = jnp.linalg.norm(e.reshape(-1, block or e.shape[0]), axis=1)
+        e = clamp_blocks(e, block or e.shape[0], clamps)
         delta = cap_step(method.delta(linearized, arm, target, theta, e, settings),
                          settings.max_step)
         new = jnp.clip(theta + delta, settings.lower, settings.upper)  # joint limits
         theta = jnp.where(jnp.all(jnp.isfinite(new)), new, theta)  # never NaN: keep the last finite
         e_after = task.error(arm, target, theta)
-        err = jnp.sum(jnp.linalg.norm(e_after.reshape(-1, block or e_after.shape[0]), axis=1))
-        return theta, (theta, err)
+        after = jnp.linalg.norm(e_after.reshape(-1, block or e_after.shape[0]), axis=1)
+        # Buss's growing clamp: D_max plus how much farther from its target the step left it
+        clamps = jnp.where(grow, d_max + jnp.maximum(after - before, 0.0), d_max)
+        return (theta, clamps), (theta, jnp.sum(after))
 
-    return jax.lax.scan(step, theta0, targets)
+    return jax.lax.scan(step, start, targets)
 
 
-def _track_chunks(method, task, arm, targets, theta0, settings, d_max):
+def _track_chunks(method, task, arm, targets, theta0, settings, d_max, grow=False):
     """Run the path CHUNK steps at a time, the last chunk padded by repeating the last target
     (its extra steps are dropped), so every path length runs the same compiled program."""
     steps = targets.shape[0]
     padded = np.concatenate([targets, np.repeat(targets[-1:], -steps % CHUNK, axis=0)])
-    theta, thetas, errors = jnp.asarray(theta0), [np.asarray(theta0)[None]], []
+    effectors = int(np.prod(targets.shape[1:])) // getattr(task, "block_size", int(np.prod(targets.shape[1:])))
+    first_clamp = jnp.full(effectors, jnp.inf if grow else d_max)  # Buss: the first step unclamped
+    carry, thetas, errors = (jnp.asarray(theta0), first_clamp), [np.asarray(theta0)[None]], []
     for first in range(0, padded.shape[0], CHUNK):
-        theta, (chunk_thetas, chunk_errors) = _track(method, task, arm, padded[first: first + CHUNK],
-                                                     theta, settings, d_max)
+        carry, (chunk_thetas, chunk_errors) = _track(method, task, arm, padded[first: first + CHUNK],
+                                                     carry, settings, d_max, jnp.asarray(grow))
         thetas.append(np.asarray(chunk_thetas))
         errors.append(np.asarray(chunk_errors))
     return np.concatenate(thetas)[: steps + 1], np.concatenate(errors)[:steps]
 
 
-def track(arm, targets, theta0=None, method="dls", damping=DEFAULT_DAMPING, rcond=DEFAULT_RCOND,
+def track(arm, targets, theta0=None, method="dls", damping=None, rcond=DEFAULT_RCOND,
           clamp=None, max_step=None, gamma_max=GAMMA_MAX, joint_limits=None, limit_mode=None,
-          levels=None, rest_pose=None, rest_gain=None):
+          levels=None, rest_pose=None, rest_gain=None, clamp_growth=False):
     """Follow targets[0], targets[1], ... with one step of `method` each (Buss's protocol).
 
     targets  (T, *target shape): one target (or one per end effector) per time step, T >= 1
              (an empty path raises a ValueError). Numbers are checked as in ik.solve.
+    damping  DLS's lambda (default L / 6, as in ik.solve).
     clamp    D_max: each end effector's error is clamped to at most D_max before the step.
+    clamp_growth  Buss's demo code (UpdatedSClampValue): effector k's clamp is D_max plus how
+             much farther from its target the last step left it (0 if nearer), and the first
+             step is unclamped. Needs clamp.
     max_step cap on any joint's change per step (radians).
     joint_limits, limit_mode, levels, rest_pose, rest_gain: as in ik.solve.
     """
@@ -106,7 +119,8 @@ def track(arm, targets, theta0=None, method="dls", damping=DEFAULT_DAMPING, rcon
     check_method_target(method, task, arm, "targets")
     theta0 = np.zeros(arm.n_joints) if theta0 is None else as_array(theta0, "theta0", shape=(arm.n_joints,))
     settings = Settings(
-        tol=0.0, damping=as_number(damping, "damping", minimum=0),
+        tol=0.0, damping=as_number(default_damping(task, arm) if damping is None else damping,
+                                   "damping", minimum=0),
         rcond=as_number(rcond, "rcond", minimum=0), clamp=np.inf,
         max_step=np.inf if max_step is None else as_number(max_step, "max_step", minimum=0, strict=True),
         stall_tol=0.0, gamma_max=as_number(gamma_max, "gamma_max", minimum=0, strict=True))
@@ -116,6 +130,10 @@ def track(arm, targets, theta0=None, method="dls", damping=DEFAULT_DAMPING, rcon
                                            limit_mode, batch=True)
     require_traceable(method, task, arm, first[0], theta0, settings)  # track compiles the step
     d_max = np.inf if clamp is None else as_number(clamp, "clamp", minimum=0, strict=True)
+    if clamp_growth not in (True, False):
+        raise ValueError(f"clamp_growth: expected True or False, got {clamp_growth!r:.80}")
+    if clamp_growth and clamp is None:
+        raise ValueError("clamp_growth: grows the clamp D_max; give clamp= too")
     thetas, errors = _track_chunks(method, task, arm, np.asarray(targets), theta0, settings,
-                                   jnp.asarray(d_max))
+                                   jnp.asarray(d_max), bool(clamp_growth))
     return TrackResult(thetas, errors)
