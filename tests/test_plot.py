@@ -198,12 +198,13 @@ def test_save_gif_writes_every_frame_as_drawn_by_frame_pngs(tmp_path):
     from PIL import Image
 
     anim = _animation("clips")
+    anim._fig.set_dpi(100)  # its own dpi, whatever rcParams an earlier test left
     path = plot.save_gif(anim, tmp_path / "walk.gif", fps=5, dpi=80)
     gif = Image.open(path)
     assert gif.n_frames == len(anim.iterations) == 5 and gif.info["duration"] == 200
     assert gif.size == (round(7.2 * 80), round(5.8 * 80))
     dpi = anim._fig.dpi
-    assert dpi != 80  # the figure's own dpi is given back
+    assert dpi == 100  # the figure's own dpi is given back
     gif.seek(2)
     anim._fig.set_dpi(80)
     png = _png_pixels(plot.frame_pngs(anim)[2])
