@@ -20,6 +20,9 @@ import numpy as np  # noqa: E402
 import ikteach as ik  # noqa: E402
 
 IMPORT_S = time.perf_counter() - t_import
+from ikteach._runtime import devices  # noqa: E402
+
+CPU_DEVICES = devices.use_cores()  # as ik.notebook.setup() does in the course notebooks
 METHODS = ("jt", "pinv", "dls", "sdls", "ccd", "fabrik")
 THETA0 = np.array([0.1, 0.2, 0.3])
 
@@ -142,7 +145,8 @@ def main():
     ap.add_argument("--skip-new-kernel", action="store_true")
     args = ap.parse_args()
     rng = np.random.default_rng(0)
-    print(f"import ikteach: {IMPORT_S * 1e3:.0f} ms (this process, numpy included)")
+    print(f"import ikteach: {IMPORT_S * 1e3:.0f} ms (this process, numpy included); "
+          f"CPU devices: {CPU_DEVICES}")
     arm = ik.planar_chain([1.0, 1.0, 1.0])
     solve_rows(arm, args.n, rng)
     if not args.skip_demo:

@@ -16,6 +16,7 @@ import jax
 import numpy as np
 
 import ikteach as ik
+from ikteach._runtime import devices
 from ikteach.core import batch as batch_module
 from ikteach.core.solve import STALL_FRACTION
 
@@ -74,13 +75,16 @@ def main():
     ap.add_argument("--numpy-subset", type=int, default=2048)
     ap.add_argument("--repeats", type=int, default=3)
     args = ap.parse_args()
+    print(f"CPU devices: {devices.use_cores()} (one per core, as ik.notebook.setup() asks)")
 
     arm = ik.planar_chain(LENGTHS)
     half = 1.1 * LENGTHS.sum()
     xs = np.linspace(-half, half, args.n)
     X, Y = np.meshgrid(xs, xs)
     targets = np.stack([X.ravel(), Y.ravel()], axis=1)
-    kw = dict(method="dls", tol=TOL, max_iter=MAX_ITER, damping=DAMPING)
+    # the C and numpy loops use the report's stop rule (sum |delta theta_i| < STALL_FRACTION * L)
+    kw = dict(method="dls", tol=TOL, max_iter=MAX_ITER, damping=DAMPING, stop_rule="joint_steps",
+              stall_tol=STALL_FRACTION * LENGTHS.sum())
 
     split = batch_module.split_devices(len(targets))
     t0 = time.perf_counter()

@@ -6,6 +6,7 @@ from jax import monitoring
 
 import ikteach as ik
 from ikteach.core.kinematics import end_path
+from ikteach.core.solve import TRACE_CHUNK
 
 ARM = ik.planar_chain([1.0, 1.0, 1.0])
 START = np.array([0.1, 0.2, 0.3])
@@ -96,7 +97,8 @@ def test_a_new_max_iter_or_a_long_solve_compiles_nothing_new():
     ik.solve(ARM, [1.5, 1.0], START, method="jt", max_iter=300)
     ik.solve_batch(ARM, np.array([[1.0, 1.0], [9.0, 0.0]]), START, method="jt", max_iter=300)
     before = len(COMPILES)
-    for max_iter in (1, 2, 63, 64, 65, 129, 4096, 10**6):
+    chunk = TRACE_CHUNK
+    for max_iter in (1, 2, chunk - 1, chunk, chunk + 1, 2 * chunk + 1, 4096, 10**6):
         res = ik.solve(ARM, [9.0, 0.0], START, method="jt", max_iter=max_iter, stall_tol=0)
         assert res.iterations == max_iter or res.status != "max_iter"
         assert res.trace.theta.shape == (res.iterations + 1, 3)
@@ -121,8 +123,9 @@ def test_the_trace_follows_the_iterations_not_max_iter():
 def test_a_trace_across_chunks_is_the_trace_of_one_long_run(method):
     """Iterates recorded across chunk boundaries: each row is the step from the row before,
     and the errors are the errors of those rows."""
-    res = ik.solve(ARM, [2.9, 0.4], START, method=method, max_iter=200, stall_tol=0, tol=1e-12)
-    assert res.iterations > 64 or res.status != "max_iter"
+    res = ik.solve(ARM, [2.9, 0.4], START, method=method, max_iter=2 * TRACE_CHUNK + 50,
+                   stall_tol=0, tol=1e-12)
+    assert res.iterations > TRACE_CHUNK or res.status != "max_iter"
     for k in range(res.iterations + 1):
         err = np.linalg.norm(np.array([2.9, 0.4]) - np.asarray(ik.fk(ARM, res.trace.theta[k])))
         assert abs(err - res.trace.error[k]) < 1e-12, k

@@ -11,25 +11,24 @@ buy speed and can each be turned off without changing a result.
 
 2. A bound on what one process keeps compiled. Each whole-loop program holds about 140 memory
    mappings and 5 MB; a kernel used all lecture long would otherwise reach the system's limit
-   on mappings (vm.max_map_count, 65530 on Debian) and die. When MAX_PROGRAMS distinct
-   programs have been compiled since the last clear, JAX's caches are cleared with its public
+   on mappings (vm.max_map_count, 65530 on Debian) and die. When MAX_PROGRAMS programs have
+   been compiled since the last clear (counted by JAX's public compile events, which cost
+   nothing per call), JAX's caches are cleared with its public
    jax.clear_caches(): the programs still in use compile again, or load from JAX's persistent
    compilation cache when ik.notebook.setup() turned it on (benchmarks/many_programs.py shows
-   mappings and memory levelling off). MAX_PROGRAMS = 192 is about 27,000 mappings, well under
+   mappings and memory levelling off). MAX_PROGRAMS = 256 is about 27,000 mappings, well under
    the limit, and above the 6 methods x 12 joint counts x 2 dimensions a whole course uses (a
    lower bound would clear and recompile over and over). IKTEACH_MAX_PROGRAMS=0 turns it off.
 """
 import functools
-import inspect
 import os
-from collections import OrderedDict
 
 import jax
 
 OPTIONS_ENV = "IKTEACH_XLA_OPTIONS"
 BOUND_ENV = "IKTEACH_MAX_PROGRAMS"
 FAST_COMPILE = {"xla_cpu_use_fusion_emitters": False}
-MAX_PROGRAMS = 192
+MAX_PROGRAMS = 256
 
 
 def supported(options):
@@ -60,37 +59,34 @@ def max_programs():
         raise ValueError(f"{BOUND_ENV}: expected a whole number of programs, got {value!r}") from None
 
 
-_seen = OrderedDict()  # program key -> None, least recently used first
+compiled = [0]  # programs JAX compiled since the last clear (all of them: loops and small ops)
 clears = [0]  # how many times the bound cleared JAX's caches (read by tests and benchmarks)
 
 
-def _signature(x):
-    shape = getattr(x, "shape", None)
-    if shape is not None:
-        return (tuple(shape), str(x.dtype))
-    return type(x).__name__  # Python numbers are traced as weakly typed scalars
+def _count(event, duration, **kwargs):
+    if event.endswith("backend_compile_duration"):
+        compiled[0] += 1
 
 
-def note_program(key):
-    """Count a program; past the bound, clear JAX's caches and start counting again."""
-    if key in _seen:
-        _seen.move_to_end(key)
-        return
+jax.monitoring.register_event_duration_secs_listener(_count)  # public: JAX's own compile events
+
+
+def keep_within_bound():
+    """Past max_programs() compiled programs, clear JAX's caches and start counting again.
+    Called before each whole-loop program runs (never while JAX is compiling)."""
     bound = max_programs()
-    if bound and len(_seen) >= bound:
+    if bound and compiled[0] >= bound:
         jax.clear_caches()
-        _seen.clear()
+        compiled[0] = 0
         clears[0] += 1
-    _seen[key] = None
 
 
 class Program:
-    """A jitted whole-loop program that counts the distinct programs it compiles."""
+    """A jitted whole-loop program, run within the bound on compiled programs."""
 
     def __init__(self, fun, static_argnames=(), fast_compile=True):
         self.fun, self.static_argnames, self.fast_compile = fun, tuple(static_argnames), fast_compile
         self._jitted = None
-        self._signature = inspect.signature(fun)
         functools.update_wrapper(self, fun)
 
     def jitted(self):
@@ -106,18 +102,14 @@ class Program:
             self._jitted.clear_cache()
 
     def __call__(self, *args, **kwargs):
-        bound = self._signature.bind(*args, **kwargs).arguments
-        static = tuple((k, bound[k]) for k in self.static_argnames if k in bound)
-        dynamic = [v for k, v in bound.items() if k not in self.static_argnames]
-        leaves, tree = jax.tree_util.tree_flatten(dynamic)
-        note_program((self.fun, static, tree, tuple(_signature(x) for x in leaves)))
+        keep_within_bound()
         return self.jitted()(*args, **kwargs)
 
 
 def jit(fun=None, fast_compile=True, static_argnames=()):
     """Program(fun): jax.jit with compiler_options() and the bound above; as a decorator with
     or without arguments (`@jit`, `@partial(jit, static_argnames=...)`). Static arguments are
-    are named in static_argnames. fast_compile=False compiles exactly as jax.jit does."""
+    named in static_argnames. fast_compile=False compiles exactly as jax.jit does."""
     if fun is None:
         return functools.partial(jit, fast_compile=fast_compile, static_argnames=static_argnames)
     return Program(fun, static_argnames, fast_compile)

@@ -175,7 +175,7 @@ def advance(method, task, arm, target, settings, max_iter, state, first=0):
                  status, trace_theta, trace_error)
 
 
-TRACE_CHUNK = 64   # iterations per compiled run when the trace is kept (memory follows the work)
+TRACE_CHUNK = 256  # iterations per compiled run when the trace is kept (memory follows the work)
 MAX_ITER_CAP = 10**6  # the largest max_iter accepted: a full trace of 12 joints is then 100 MB
 
 
@@ -231,8 +231,11 @@ def _run_eager(method, task, arm, target, state, settings, max_iter):
 def run_chunks(run, method, task, arm, target, theta0, settings, max_iter):
     """Run the loop chunk by chunk (run: _run_jit or _run_eager) until it stops; returns the
     last state (on the host) and the whole trace, theta (k + 1, n) and error (k + 1,)."""
-    state, thetas, errors = initial_state(theta0, True), [], []
-    max_iter = np.int64(max_iter)
+    theta0 = np.asarray(theta0)  # the start state built on the host: no small device programs
+    n, rows = theta0.shape[0], TRACE_CHUNK + 1
+    state = State(np.int64(0), theta0, np.float64(np.inf), np.float64(np.inf), np.int64(RUNNING),
+                  np.zeros((rows, n)), np.zeros(rows))
+    thetas, errors, max_iter = [], [], np.int64(max_iter)
     while True:
         first = int(state.i)
         state = jax.device_get(run(method, task, arm, target, state, settings, max_iter))

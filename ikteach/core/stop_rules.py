@@ -105,23 +105,31 @@ def stall_kind(task, arm, target, theta, lower, upper):
     return jnp.where(stationary, jnp.where(saddle, SADDLE, MINIMUM), CUT_SHORT)
 
 
+STALL_BLOCKS = (8, 1024)  # rows per call: a solve's, a batch's
+
+
 @partial(runtime_jit.jit, static_argnames=("task",))
 def _stall_kinds(task, arm, targets, thetas, lower, upper):
     return jax.vmap(lambda t, q: stall_kind(task, arm, t, q, lower, upper))(targets, thetas)
 
 
 def why_stalled(method, task, arm, targets, thetas, stalled, settings):
-    """stall_kind of every row where `stalled` (MINIMUM elsewhere). Rows are padded to a power
-    of two: one compiled program per size class. Prioritised solves (levels, a rest pose) stop
+    """stall_kind of every row where `stalled` (MINIMUM elsewhere). Rows go in blocks of
+    STALL_BLOCKS[0] (a few rows: a solve) or STALL_BLOCKS[1] (a batch), the last one padded:
+    two compiled programs per problem, whatever the count (a new count would otherwise compile
+    again: 0.3-0.5 s on a live map's lambda change). Prioritised solves (levels, a rest pose) stop
     at a compromise between levels, not at a minimum of ||e||: they are left as they are."""
     kinds = np.full(np.shape(stalled), MINIMUM)
     rows = np.flatnonzero(stalled)
     inner = method.inner if isinstance(method, LimitedMethod) else method
     if rows.size == 0 or isinstance(inner, PriorityMethod):
         return kinds
-    padded = np.concatenate([rows, np.repeat(rows[-1:], (1 << int(rows.size - 1).bit_length()) - rows.size)])
+    block = STALL_BLOCKS[0] if rows.size <= STALL_BLOCKS[0] else STALL_BLOCKS[1]
+    padded = np.concatenate([rows, np.repeat(rows[-1:], -rows.size % block)])
     n = np.shape(thetas)[-1]
-    bounds = [jnp.broadcast_to(jnp.asarray(b, dtype=float), (n,)) for b in (settings.lower, settings.upper)]
-    kinds[rows] = np.asarray(_stall_kinds(task, arm, np.asarray(targets)[padded],
-                                          np.asarray(thetas)[padded], *bounds))[: rows.size]
+    bounds = [np.broadcast_to(np.asarray(b, dtype=float), (n,)) for b in (settings.lower, settings.upper)]
+    targets, thetas = np.asarray(targets), np.asarray(thetas)
+    found = [_stall_kinds(task, arm, targets[part], thetas[part], *bounds)
+             for part in padded.reshape(-1, block)]
+    kinds[rows] = np.concatenate([np.asarray(f) for f in found])[: rows.size]
     return kinds
