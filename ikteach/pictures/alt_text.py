@@ -37,7 +37,7 @@ def _axes_text(ax):
 
 def figure_alt(fig):
     """One line describing a figure from its suptitle, axes titles and axis labels."""
-    suptitle = plain(fig._suptitle.get_text()) if getattr(fig, "_suptitle", None) else ""
+    suptitle = plain(fig.get_suptitle())
     panels = [t for t in (_axes_text(ax) for ax in fig.axes) if t]
     n = len(fig.axes)
     lead = suptitle or ("Figure" if n <= 1 else f"Figure with {n} panels")
@@ -80,34 +80,5 @@ def register(shell):
     formatters["image/svg+xml"].pop(Figure, None)
     formatters["text/html"].for_type(Figure, figure_html)
     formatters["text/plain"].for_type(Figure, lambda fig, p, cycle: p.text(figure_alt(fig)))
-    skip_unseen_draws(shell)
     return True
 
-
-def skip_unseen_draws(shell):
-    """pyplot redraws every stale figure after each cell (a full draw). A figure on the inline
-    backend's plain Agg canvas has no screen to update: the inline backend draws it again to
-    display it, so that first draw only cost time (a third of a cell's plotting). Figures with
-    a screen (ipympl widgets, windows) are still drawn. Returns True when the hook was swapped."""
-    import matplotlib.pyplot as plt
-
-    try:
-        shell.events.unregister("post_execute", plt._draw_all_if_interactive)
-    except (AttributeError, ValueError):  # another matplotlib, or not registered: leave it
-        return False
-    shell.events.register("post_execute", draw_stale_figures_with_a_screen)
-    return True
-
-
-def draw_stale_figures_with_a_screen():
-    """pyplot's draw_all after a cell, less the figures on a plain Agg canvas."""
-    import matplotlib
-    from matplotlib._pylab_helpers import Gcf
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-
-    if not matplotlib.is_interactive():
-        return
-    for manager in Gcf.get_all_fig_managers():
-        canvas = manager.canvas
-        if canvas.figure.stale and type(canvas) is not FigureCanvasAgg:
-            canvas.draw_idle()
