@@ -80,6 +80,26 @@ def test_drawings_show_every_bone(clip):
         character_plot.draw_skeleton(ax, rig, points, "diagonal")
 
 
+def test_views_are_not_mirrored(clip):
+    """Seen from above (z forward up the page) the left foot is on the page's left; seen from
+    the front it is on the page's right; drawing twice on one axes keeps the top view right."""
+    import matplotlib.pyplot as plt
+
+    sk, _, root, theta = clip
+    rig = skeleton.rig(sk)
+    points = skeleton.world_points(rig, root, theta)[0]
+    left, right = rig.points.index("LeftFoot"), rig.points.index("RightFoot")
+    for view, left_on_the_left in (("top", True), ("front", False)):
+        fig, ax = plt.subplots()
+        for _ in range(2):
+            character_plot.draw_skeleton(ax, rig, points, view)
+        fig.canvas.draw()
+        i, j = character_plot.VIEWS[view]
+        screen = ax.transData.transform(points[[left, right]][:, [i, j]])
+        assert (screen[0, 0] < screen[1, 0]) == left_on_the_left, view
+        plt.close(fig)
+
+
 def test_character_scene_renders_off_screen(clip):
     sk, _, root, theta = clip
     rig = skeleton.rig(sk)

@@ -62,6 +62,26 @@ def test_planting_makes_no_pops(cleanup):
     assert footplant.largest_step(cleanup.theta_after) <= 1.5 * footplant.largest_step(cleanup.theta_before)
 
 
+def test_planted_toes_stay_on_the_floor_and_the_feet_keep_the_clips_orientation(cleanup):
+    """The retargeted clip puts the toes 0.3 cm under the floor; the cleaned one never below it
+    (floor 0, tolerance of the solve), and each foot keeps the clip's ankle-to-toe vector
+    instead of pitching with the knee (without the toe rows it pitched them 1 cm under)."""
+    assert cleanup.toes_before[..., 1].min() < -0.2
+    assert cleanup.toes_after[..., 1].min() > -1e-3
+    foot_before = cleanup.toes_before - cleanup.feet_before
+    foot_after = cleanup.toes_after - cleanup.feet_after
+    assert np.abs(foot_after - foot_before).max() < 1e-2
+
+
+def test_floor_lift_moves_a_foot_up_as_one_piece():
+    targets = np.zeros((2, 1, 2, 3))
+    targets[:, 0, :, 1] = [[8.0, -0.5], [9.0, 2.0]]        # frame 0: toe under the floor
+    lifted = footplant.floor_lift(targets, 0.0)
+    np.testing.assert_allclose(lifted[:, 0, :, 1], [[8.5, 0.0], [9.0, 2.0]])
+    with pytest.raises(ValueError, match="^floor:"):
+        footplant.floor_lift(targets, "low")
+
+
 def test_foot_skate_counts_only_frames_in_contact():
     positions = np.zeros((4, 1, 3))
     positions[:, 0, 0] = [0, 1, 3, 6]             # steps of 1, 2, 3 along x
@@ -95,9 +115,10 @@ def test_bad_input_names_the_parameter(clip, cleanup):
     with pytest.raises(ValueError, match="^joint: expected one of"):
         footplant.retarget(sk, motion, {"Tail": 2})
     rig, root = cleanup.rig, cleanup.root
+    targets = cleanup.all_targets                  # ankles, then toes
     with pytest.raises(ValueError, match="^targets: expected shape"):
-        clip_ik.solve_clip(rig, root, cleanup.theta_before, cleanup.targets[:, :1], [0])
+        clip_ik.solve_clip(rig, root, cleanup.theta_before, cleanup.targets, [0])
     with pytest.raises(ValueError, match="^active: expected indices"):
-        clip_ik.solve_clip(rig, root, cleanup.theta_before, cleanup.targets, [rig.n_joints])
+        clip_ik.solve_clip(rig, root, cleanup.theta_before, targets, [rig.n_joints])
     with pytest.raises(ValueError, match="^damping:"):
-        clip_ik.solve_clip(rig, root, cleanup.theta_before, cleanup.targets, [0], damping=-1)
+        clip_ik.solve_clip(rig, root, cleanup.theta_before, targets, [0], damping=-1)

@@ -6,8 +6,11 @@ clean a clip with IK so that planted feet stay put.
 2. skate:     horizontal foot travel summed over consecutive contact frames, sum |dx_xz|.
 3. targets:   in each contact interval the foot aims at one point, the mean of where it was;
    between contacts the correction (target - foot) is interpolated, so the targets glide.
-4. clean:     frame by frame, the solve loop (DLS) moves only the hips and knees to put the
-   feet on their targets (ik.clip_ik.solve_clip), warm-started from the previous frame.
+4. clean:     frame by frame, the solve loop (DLS) moves only the hips, knees and ankle hinges
+   to put the feet on their targets (ik.clip_ik.solve_clip), warm-started from the previous
+   frame. Each toe (the foot's end site) aims at its ankle's target plus the clip's own
+   ankle-to-toe vector, so the foot keeps the clip's orientation instead of pitching as the
+   knee bends; every target is lifted to stay on or above the floor.
 """
 import dataclasses
 
@@ -112,19 +115,33 @@ def largest_step(theta):
 
 
 def leg_joints(rig, foot):
-    """The revolute joints that place a foot: its hip (the foot's grandparent, all channels)
-    and its knee (the foot's parent, a hinge: Xrotation only)."""
+    """The revolute joints that place a foot: its hip (the foot's grandparent, all channels),
+    its knee (the foot's parent, a hinge: Xrotation only) and its own hinge (Xrotation: the
+    foot's pitch, which keeps the toe where it should be)."""
     sk = rig.skeleton
     knee = sk.parents[sk.index(foot)]
     hip = sk.parents[knee]
     if knee < 0 or hip < 0:
         raise ValueError(f"feet: {foot!r} needs a knee and a hip above it")
-    return rig.revolutes(sk.names[hip]) + rig.revolutes(sk.names[knee], ["Xrotation"])
+    return (rig.revolutes(sk.names[hip]) + rig.revolutes(sk.names[knee], ["Xrotation"])
+            + rig.revolutes(foot, ["Xrotation"]))
+
+
+def floor_lift(targets, floor):
+    """Targets (F, k, p, 3) (frame, foot, the foot's points) moved up, per frame and foot, by
+    just enough that none of the foot's points is below `floor` (their heights keep their
+    differences, so a flat foot stays flat)."""
+    targets = np.array(targets, float)
+    floor = as_number(floor, "floor")
+    lift = np.maximum(0.0, floor - targets[..., UP].min(axis=-1))
+    targets[..., UP] += lift[..., None]
+    return targets
 
 
 @dataclasses.dataclass(frozen=True)
 class Cleanup:
-    """A retargeted clip before and after foot planting (positions of the feet (F, k, 3))."""
+    """A retargeted clip before and after foot planting: positions of the feet (ankles) and
+    toes (F, k, 3); targets (F, k, 3) are the ankles'."""
     rig: object
     root: np.ndarray
     contact: np.ndarray          # (F, k) detected on the original clip
@@ -134,6 +151,14 @@ class Cleanup:
     feet_after: np.ndarray
     targets: np.ndarray
     result: ClipResult
+    toes_before: np.ndarray = None
+    toes_after: np.ndarray = None
+    toe_targets: np.ndarray = None
+
+    @property
+    def all_targets(self):
+        """What solve_clip was given: (F, 2k, 3), the ankles' targets then the toes'."""
+        return np.concatenate([self.targets, self.toe_targets], axis=1)
 
     @property
     def skate_before(self):
@@ -145,20 +170,28 @@ class Cleanup:
 
 
 def clean_clip(skeleton, motion, scales, feet=("LeftFoot", "RightFoot"), height=9.0, speed=15.0,
-               **solve_options):
+               floor=0.0, **solve_options):
     """The whole pipeline: contacts on the original clip, retarget with `scales` (the feet
-    skate), plant targets, IK frame by frame on the hips and knees. Returns a Cleanup."""
+    skate), plant targets (lifted onto `floor`, None: no floor), IK frame by frame on the hips,
+    knees and ankle hinges, the toes (each foot's end site) keeping the clip's ankle-to-toe
+    vector. Returns a Cleanup."""
     from .skeleton import angles, rig as make_rig, world_points
 
     original = make_rig(skeleton, feet)
     root, theta = angles(original, motion.frames)
     contact = contacts(world_points(original, root, theta), motion.frame_time, height, speed)
     new_skeleton, new_motion = retarget(skeleton, motion, scales)
-    rig = make_rig(new_skeleton, feet)
+    k = len(feet)
+    rig = make_rig(new_skeleton, list(feet) + [f + "_end" for f in feet])
     root, theta = angles(rig, new_motion.frames)
     before = world_points(rig, root, theta)
-    targets = plant_targets(before, contact)
+    ankle = plant_targets(before[:, :k], contact)
+    both = np.stack([ankle, ankle + before[:, k:] - before[:, :k]], axis=2)   # (F, k, 2, 3)
+    if floor is not None:
+        both = floor_lift(both, floor)
+    targets = np.concatenate([both[:, :, 0], both[:, :, 1]], axis=1)
     active = sum((leg_joints(rig, f) for f in feet), [])
     result = solve_clip(rig, root, theta, targets, active, **solve_options)
-    return Cleanup(rig, root, contact, theta, result.theta, before,
-                   world_points(rig, root, result.theta), targets, result)
+    after = world_points(rig, root, result.theta)
+    return Cleanup(rig, root, contact, theta, result.theta, before[:, :k], after[:, :k],
+                   targets[:, :k], result, before[:, k:], after[:, k:], targets[:, k:])

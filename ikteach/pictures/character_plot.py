@@ -3,6 +3,9 @@ feet's paths against their contacts, and clips side by side as an animation."""
 import numpy as np
 
 VIEWS = {"side": (2, 1), "front": (0, 1), "top": (0, 2)}   # BVH: z forward, y up, x left
+# Seen from above with z (forward) up the page, the character's left (+x) is on the page's
+# left: the top view's x axis runs right to left (the front view's runs left to right).
+MIRRORED = {"top"}
 
 
 def _plane(view):
@@ -34,7 +37,9 @@ def draw_skeleton(ax, rig, points, view="side", color=None, alpha=1.0, label=Non
              for k, (s, c) in enumerate(zip(stick_segments(rig, points), colors))]
     dots = ax.plot(np.asarray(points)[:, i], np.asarray(points)[:, j], "o", color="k", ms=2.5, alpha=alpha)[0]
     ax.set_aspect("equal", adjustable="datalim")
-    ax.set_xlabel("xyz"[i] + " (cm)")
+    if view in MIRRORED and not ax.xaxis_inverted():
+        ax.invert_xaxis()
+    ax.set_xlabel("xyz"[i] + (" (cm, increasing to the left)" if view in MIRRORED else " (cm)"))
     ax.set_ylabel("xyz"[j] + " (cm)")
     return lines, dots
 
