@@ -14,7 +14,7 @@ export UV_PYTHON_DOWNLOADS := never
 # may not write them itself, e.g. PYTHONDONTWRITEBYTECODE, a read-only venv).
 SYNC := $(UV) sync --locked --inexact --extra dev --compile-bytecode
 
-.PHONY: lab test test-latest test-lowest lock lock-upgrade header notebooks strip bench clean exercises test-browser
+.PHONY: lab test test-latest test-lowest lock lock-upgrade header notebooks strip bench clean exercises test-browser bench-browser
 
 # uv itself comes from PyPI, into the venv (the lock then keeps it at its locked version).
 $(UV):
@@ -124,3 +124,11 @@ test-browser: $(STAMP)
 	  { $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq chromium chromium-driver; }
 	$(PY) -m pip install --quiet "selenium>=4.20"
 	$(PY) -m pytest -v -p no:cacheprovider tests/browser/lab_05.py
+
+# Browser latency (a benchmark: prints p50/p95, asserts nothing): slider -> picture redrawn
+# in JupyterLab in headless Chromium. Run on an idle machine; not part of `make test`.
+bench-browser: $(STAMP)
+	@test -x /usr/bin/chromium -a -x /usr/bin/chromedriver || \
+	  { $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq chromium chromium-driver; }
+	$(PY) -m pip install --quiet "selenium>=4.20"
+	$(PY) tests/browser/bench_latency.py
