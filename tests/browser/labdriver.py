@@ -133,7 +133,7 @@ def run_all(driver, url, name, code_cells, timeout=600):
     """Open notebook `name` in JupyterLab, Run All Cells and wait until every code cell has run."""
     from selenium.webdriver.common.by import By
 
-    driver.get(f"{url}/lab/tree/{name}?token={TOKEN}")
+    driver.get(f"{url}/lab/tree/{name}?token={TOKEN}&reset")  # reset: no earlier tab restored
     wait_until(lambda: driver.find_elements(By.CSS_SELECTOR, ".jp-Notebook .jp-Cell"), 120,
                "the notebook to open")
     wait_until(lambda: "idle" in kernel_states(url), 180, "the kernel to start")
