@@ -29,7 +29,7 @@ def test_update_solves_like_ik_solve_and_prints_method_status_iterations(demo):
     assert (res.status, res.iterations) == (ref.status, ref.iterations)
     assert demo.text.value == demo.summary
     assert demo.summary.startswith("jt: converged after") and str(ref.iterations) in demo.summary
-    assert demo.image.value[:4] == b"\x89PNG"
+    assert demo.image.value == demo.svg and demo.svg.startswith("<svg")
 
 
 def test_moving_a_slider_re_solves(demo):
@@ -69,7 +69,7 @@ def test_an_unknown_preset_name_is_a_value_error_naming_the_presets(demo):
         demo.preset.value = "far away"
 
 
-def test_the_image_is_rendered_at_twice_its_css_size_and_changes_with_the_target(demo):
+def test_the_still_is_rendered_at_twice_its_css_size_and_changes_with_the_target(demo):
     from PIL import Image
     import io
 
@@ -79,8 +79,29 @@ def test_the_image_is_rendered_at_twice_its_css_size_and_changes_with_the_target
     assert image.size == (ikdemo.HIDPI * ikdemo.SIZE,) * 2
     assert demo.image.layout.width == f"{ikdemo.SIZE}px"
     demo.update(x=1.0, y=1.5)
-    assert demo.png != before and demo.image.value == demo.png
+    assert demo.png != before
     assert "(1.00, 1.50)" in demo.alt and demo.summary in demo.alt
+
+
+def test_the_live_picture_is_an_svg_of_the_solved_arm_named_by_its_alt_text(demo):
+    import xml.etree.ElementTree as ET
+
+    res = demo.update(x=1.0, y=1.5, method="pinv")
+    svg = ET.fromstring(demo.image.value)
+    ns = "{http://www.w3.org/2000/svg}"
+    assert svg.get("role") == "img" and svg.get("aria-label") == demo.alt
+    assert svg.find(f"{ns}title").text == demo.alt
+    # the arm: a polyline in the method's colour from the base (the picture's centre) to the
+    # end effector, |F(theta)| from the base at the picture's scale (98 % of SIZE is 2.6 reach)
+    arm = [p for p in svg.iter(f"{ns}polyline") if p.get("stroke") == "#d62728"]
+    assert len(arm) == 1
+    points = np.array([xy.split(",") for xy in arm[0].get("points").split()], dtype=float)
+    assert len(points) == ARM.n_joints + 1
+    np.testing.assert_allclose(points[0], [ikdemo.SIZE / 2] * 2, atol=0.06)
+    scale = 0.98 * ikdemo.SIZE / (2 * 1.3 * 3.0)
+    end = np.asarray(ik.fk(ARM, res.theta))[:2]
+    np.testing.assert_allclose(points[-1], [200 + end[0] * scale, 200 - end[1] * scale], atol=0.06)
+    assert len(demo.svg) < 8000  # a few kB per move, not a PNG
 
 
 def test_png_writer_round_trips_pixels():

@@ -5,24 +5,29 @@
     demo.update(x=3.5, y=1.0)      # what a slider change does; returns the Result
 
 Every change re-solves from the same start theta0 with ik.solve, redraws the arm, its
-start pose and the end effector's path into an image widget, and prints one line:
-method, status and iterations. The solve is compiled once per method (the target and
-lambda are traced numbers), so a change costs a few milliseconds of solving plus one
-PNG render. Without a browser, call update() and read .result, .summary, .png.
+start pose and the end effector's path, and prints one line: method, status and
+iterations. The solve is compiled once per method (the target and lambda are traced
+numbers), so a change costs a few milliseconds of solving. The picture the browser shows is
+a small SVG (a few kB: lines, dots and a circle, drawn by the browser, sharp at any zoom;
+role="img" with the alt text as its name) in an HTML widget: no PNG to render, send or
+decode per move. Without a browser, call update() and read .result, .summary, .svg, .png.
 
-The image is SIZE x SIZE CSS pixels beside its controls (fits a 1280x720 laptop screen
-with JupyterLab around it; narrower, at 200 % zoom, the controls wrap under it and the image
-shrinks to the page's width), rendered at HIDPI times that so it stays sharp on HiDPI
-screens. Only the moving artists are redrawn over a cached background (blitting), and
-the PNG is written with light compression. Displayed, the widget also carries a still
-(PNG + status line) that static pages (GitHub, nbconvert HTML) show in its place.
+The picture is SIZE x SIZE CSS pixels beside its controls (fits a 1280x720 laptop screen
+with JupyterLab around it; narrower, at 200 % zoom, the controls wrap under it and the
+picture shrinks to the page's width). Displayed, the widget also carries a still (a PNG
+drawn by matplotlib at HIDPI x SIZE pixels, with alt text, + status line) that static pages
+(GitHub, nbconvert HTML) show in its place; .png draws it (only the moving artists, over a
+cached background).
 
 The target sliders move in steps of STEP and every preset lies on that grid: the browser
 snaps a slider to its grid and sends the snapped value back, so an off-grid preset would be
 re-solved at another target (and, during Run All, after later cells had moved on).
 """
+import html
+
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import to_hex
 from matplotlib.figure import Figure
 
 from . import plot
@@ -65,6 +70,53 @@ def padded(thetas, n):
     """thetas (k, d) with its last row repeated up to n rows, so jitted maps see one shape."""
     thetas = np.asarray(thetas, dtype=float)
     return np.concatenate([thetas, np.repeat(thetas[-1:], max(n - len(thetas), 0), axis=0)])
+
+
+def svg_picture(arm, theta0, theta, path, target, color, alt, size=SIZE, margin=1.3):
+    """The demo's picture as SVG, drawn as plot.draw_reach/draw_arm/draw_target draw it (the
+    still's PNG): the dashed reach circle, the start pose in grey, the end effector's path as
+    orange dots, the arm (joints white dots, end a square) and the target (cross). Widths in
+    CSS pixels are matplotlib's points x 100/72, as the PNG shows them at 100 dpi."""
+    base = np.asarray(arm.base, dtype=float)[:2]
+    r = margin * float(reach(arm))
+    scale = 0.98 * size / (2 * r)  # the axes fill 98 % of the picture, as in the PNG
+
+    def xy(points):
+        p = np.atleast_2d(np.asarray(points, dtype=float))[:, :2]
+        return np.stack([0.01 * size + (p[:, 0] - base[0] + r) * scale,
+                         0.99 * size - (p[:, 1] - base[1] + r) * scale], axis=1)
+
+    def pts(points):
+        return " ".join(f"{x:.1f},{y:.1f}" for x, y in xy(points))
+
+    pt = 100 / 72  # CSS pixels per point
+    arm_xy = plot._xy(arm, theta)
+    (cx, cy), (tx, ty), (ex, ey) = xy(base)[0], xy(target)[0], xy(arm_xy[-1])[0]
+    dots = "".join(f"M{x:.1f} {y:.1f}h0" for x, y in xy(path))
+    joints = "".join(f'<circle cx="{x:.1f}" cy="{y:.1f}" r="{2.5 * pt:.2f}"/>'
+                     for x, y in xy(arm_xy[:-1]))
+    c, t, e = 4.5 * pt, 3 * pt, 3 * pt  # half the cross, half the end square
+    alt = html.escape(alt, quote=True)
+    return (
+        f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {size} {size}" width="{size}" '
+        f'height="{size}" role="img" aria-label="{alt}" style="display:block;width:100%;'
+        f'height:auto;background:#fff"><title>{alt}</title>'
+        f'<rect x="{0.01 * size:.1f}" y="{0.01 * size:.1f}" width="{0.98 * size:.1f}" '
+        f'height="{0.98 * size:.1f}" fill="none" stroke="#000" stroke-width="{0.8 * pt:.2f}"/>'
+        f'<circle cx="{cx:.1f}" cy="{cy:.1f}" r="{float(reach(arm)) * scale:.1f}" fill="none" '
+        f'stroke="#999" stroke-width="{pt:.2f}" stroke-dasharray="{3.7 * pt:.1f} {1.6 * pt:.1f}"/>'
+        f'<polyline points="{pts(plot._xy(arm, theta0))}" fill="none" stroke="#b3b3b3" '
+        f'stroke-width="{2 * pt:.2f}" stroke-linecap="round" stroke-linejoin="round"/>'
+        f'<g stroke="{to_hex("C1")}" stroke-opacity="0.7" fill="none" stroke-linecap="round">'
+        f'<polyline points="{pts(path)}" stroke-width="{pt:.2f}"/>'
+        f'<path d="{dots}" stroke-width="{2 * pt:.2f}"/></g>'
+        f'<polyline points="{pts(arm_xy)}" fill="none" stroke="{color}" stroke-width="{3 * pt:.2f}" '
+        f'stroke-linecap="round" stroke-linejoin="round"/>'
+        f'<g fill="#fff" stroke="{color}" stroke-width="{pt:.2f}">{joints}</g>'
+        f'<rect x="{ex - e:.1f}" y="{ey - e:.1f}" width="{2 * e:.1f}" height="{2 * e:.1f}" '
+        f'fill="{color}"/>'
+        f'<path d="M{tx - c:.1f} {ty - c:.1f}l{2 * c:.1f} {2 * c:.1f}M{tx - c:.1f} {ty + c:.1f}'
+        f'l{2 * c:.1f} {-2 * c:.1f}" stroke="#000" stroke-width="{2 * pt:.2f}"/></svg>')
 
 
 def _widgets():
@@ -125,10 +177,10 @@ class Demo:
         self.method = w.Dropdown(options=list(METHOD_NAMES), value=method, description="method",
                                  style=style, layout=w.Layout(width="auto"))
         self.preset = PresetButtons(PRESETS, self._preset_chosen)
-        # SIZE px wide, at most the page's width (200 % zoom); height follows the width
-        self.image = w.Image(format="png", width=str(SIZE), height=str(SIZE),
-                             layout=w.Layout(width=f"{SIZE}px", max_width=FIT, height="auto",
-                                             flex="0 1 auto"))
+        # SIZE px wide, at most the page's width (200 % zoom); height follows the width.
+        # An HTML widget holding the SVG picture (its alt text is the SVG's name)
+        self.image = w.HTML(layout=w.Layout(width=f"{SIZE}px", max_width=FIT, height="auto",
+                                            flex="0 1 auto"))
         self.text = w.Label(layout=w.Layout(width="auto"))
         controls = w.VBox([self.x, self.y, self.damping, self.method, w.Label("presets"),
                            self.preset, self.text],
@@ -204,17 +256,25 @@ class Demo:
         self.summary = summary(self.method.value, self.result)
         self.alt = alt_text(self.arm, target, self.summary)  # the still's <img alt>
         self.text.value = self.summary
-        self.png = self._draw(target)
-        self.image.value = self.png
-        # no .tooltip on the image: ipywidgets 8.1's ImageView fails to render with one (it
-        # reads a description an Image does not have); the still and the status line carry it
+        thetas = self.result.trace.theta
+        self._end_path = plot.end_path(self.arm, padded(thetas, self.max_iter + 1))[: len(thetas)]
+        self._png = None  # drawn when asked for (the still)
+        self.svg = svg_picture(self.arm, self.theta0, self.result.theta, self._end_path, target,
+                               to_hex(plot.color_for(self.method.value)), self.alt)
+        self.image.value = self.svg
         self._solved = self._state()
         return self.result
 
+    @property
+    def png(self):
+        """The current picture as a PNG drawn by matplotlib (HIDPI x SIZE pixels): the still."""
+        if self._png is None:
+            self._png = self._draw(np.array([self.x.value, self.y.value]))
+        return self._png
+
     def _draw(self, target):
         """Move the animated artists, draw them over the cached background, return a PNG."""
-        thetas = self.result.trace.theta
-        path = plot.end_path(self.arm, padded(thetas, self.max_iter + 1))[: len(thetas)]
+        path = self._end_path
         self._path.set_data(path[:, 0], path[:, 1])
         plot.set_arm(self._arm, self.arm, self.result.theta)
         color = plot.color_for(self.method.value)
