@@ -1,3 +1,5 @@
+import html
+
 import numpy as np
 import pytest
 
@@ -55,7 +57,7 @@ def counted(monkeypatch):
         return real(*args, **kwargs)
 
     monkeypatch.setattr(live_map, "sweep", sweep)
-    return live_map.LiveMap(ARM, grid_n=12, max_iter=50), calls
+    return live_map.LiveMap(ARM, grid_n=12, max_iter=50, prefetch=False), calls
 
 
 def test_lambda_under_jt_and_a_new_quantity_re_solve_nothing(counted):
@@ -73,6 +75,28 @@ def test_lambda_under_jt_and_a_new_quantity_re_solve_nothing(counted):
     assert calls == ["dls", "jt", "dls"]
 
 
+def test_the_maps_one_step_either_side_are_prefetched_and_a_step_solves_nothing(monkeypatch):
+    calls = []
+    real = live_map.sweep
+
+    def sweep(*args, **kwargs):
+        calls.append((kwargs["method"], kwargs["damping"]))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(live_map, "sweep", sweep)
+    live = live_map.LiveMap(ARM, grid_n=12, max_iter=50, damping=0.5)
+    for key in [("dls", 0.55), ("dls", 0.45)]:
+        live._maps[key].result()  # the background thread solved it
+    assert sorted(calls) == [("dls", 0.45), ("dls", 0.5), ("dls", 0.55)]
+    live.damping.value = 0.55  # one step: solved already
+    assert calls.count(("dls", 0.55)) == 1
+    ref = real(ARM, live.grid, live.theta0, method="dls", damping=0.55, tol=1e-3, max_iter=50)
+    np.testing.assert_array_equal(live.result.iterations, ref.iterations)
+    live.update(method="jt")  # lambda unused: nothing prefetched
+    live.damping.value = 1.0
+    assert [c for c in calls if c[0] == "jt"] == [("jt", 0.55)]
+
+
 def test_the_map_has_a_fixed_css_size_rendered_at_hidpi_and_a_still():
     import base64
     import io
@@ -88,6 +112,9 @@ def test_the_map_has_a_fixed_css_size_rendered_at_hidpi_and_a_still():
     assert "application/vnd.jupyter.widget-view+json" in data
     assert base64.b64decode(data["image/png"]) == live.png
     assert meta["image/png"]["alt"] == live.alt and not live.image.tooltip  # see test_demo
+    # the browser's picture: an <img> with the alt text (an Image widget has no alt)
+    assert live.image.value.startswith("<img") and f'alt="{html.escape(live.alt)}"' in live.image.value
+    assert base64.b64encode(live.png).decode() in live.image.value
     assert "Workspace map" in live.alt and live.summary in live.alt
     assert 'alt="Workspace map' in data["text/html"]
     for control in (live.damping, live.method, live.quantity):

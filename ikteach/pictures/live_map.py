@@ -8,12 +8,20 @@ with ik.solve_batch and redraw the map (iterations, final error or status) as a 
 The batch is compiled once per method; a new lambda is a traced number, so a change costs
 one solve_batch over the grid and one small PNG render. Maps are kept per method and lambda
 (the JT map once: lambda does not change it), so moving lambda under JT, switching back to a
-method seen before or changing what is shown re-solves nothing.
+method seen before or changing what is shown re-solves nothing. After each redraw the maps
+one slider step either side of lambda are solved in a background thread (prefetch=True),
+while the student looks: a step of the slider then finds its map solved (a jump further,
+or a move before the prefetch ends, solves or waits as before).
 
 The map is SIZE x SIZE CSS pixels (at most the page's width), rendered at HIDPI times that;
-only the map and its title are redrawn over a cached background. Displayed, the widget also
-carries a still (PNG with alt text + status line) that static pages show in its place.
+only the map and its title are redrawn over a cached background. The browser shows it as an
+<img> with alt text in an HTML widget (an Image widget has no alt). Displayed, the widget
+also carries a still (PNG with alt text + status line) that static pages show in its place.
 """
+import base64
+import html
+from concurrent.futures import Future, ThreadPoolExecutor
+
 import numpy as np
 
 from ..core.chain import planar_chain
@@ -26,6 +34,20 @@ DAMPED = ("dls", "sdls")     # the methods whose map lambda changes
 SIZE = 360    # CSS pixels, the map's width and height on the page
 HIDPI = 2     # rendered at HIDPI x SIZE pixels
 KEPT = 64     # maps kept (per method and lambda) before the oldest is dropped
+_POOL = []    # the one background thread that prefetches maps, made when first needed
+
+
+def _background():
+    if not _POOL:
+        _POOL.append(ThreadPoolExecutor(max_workers=1, thread_name_prefix="ikteach-live-map"))
+    return _POOL[0]
+
+
+def img_html(png_bytes, alt, size=SIZE):
+    """The map as an <img> with alt text, SIZE CSS pixels wide at most the page's width."""
+    data = base64.b64encode(png_bytes).decode("ascii")
+    return (f'<img src="data:image/png;base64,{data}" alt="{html.escape(alt, quote=True)}" '
+            f'width="{size}" height="{size}" style="display:block;width:100%;height:auto">')
 
 
 def map_image(result, quantity):
@@ -57,7 +79,7 @@ class LiveMap:
     only a map not solved before."""
 
     def __init__(self, arm=None, grid_n=128, theta0=(0.3, 0.3, 0.3), method="dls",
-                 damping=0.5, quantity="iterations", tol=1e-3, max_iter=100):
+                 damping=0.5, quantity="iterations", tol=1e-3, max_iter=100, prefetch=True):
         import ipywidgets as w
 
         from .stills import with_still
@@ -66,7 +88,8 @@ class LiveMap:
         self.grid = target_grid(self.arm, n=grid_n)
         self.theta0 = np.asarray(theta0, dtype=float)
         self.tol, self.max_iter = tol, max_iter
-        self._maps = {}  # (method, lambda or None) -> SweepMap
+        self._maps = {}  # (method, lambda or None) -> SweepMap, or a Future of one (prefetch)
+        self.prefetch = prefetch
         style = {"description_width": "auto"}
         self.damping = w.FloatSlider(value=damping, min=0.0, max=2.0, step=0.05,
                                      description="λ (dls)", readout_format=".2f", style=style,
@@ -75,9 +98,10 @@ class LiveMap:
                                  style=style, layout=w.Layout(width="auto"))
         self.quantity = w.Dropdown(options=list(QUANTITIES), value=quantity, description="show",
                                    style=style, layout=w.Layout(width="auto"))
-        # a fixed CSS size (not stretched to the page), at most the page's width
-        self.image = w.Image(format="png", width=str(SIZE), height=str(SIZE),
-                             layout=w.Layout(width=f"{SIZE}px", max_width="calc(100% - 4px)", height="auto"))
+        # a fixed CSS size (not stretched to the page), at most the page's width; an HTML
+        # widget holding an <img alt=...>
+        self.image = w.HTML(layout=w.Layout(width=f"{SIZE}px", max_width="calc(100% - 4px)",
+                                            height="auto"))
         self.text = w.Label()
         controls = w.HBox([self.damping, self.method, self.quantity],
                           layout=w.Layout(flex_flow="row wrap", max_width="100%"))
@@ -118,15 +142,39 @@ class LiveMap:
         if not self._holding:
             self.update()
 
+    def _key(self, method, damping):
+        return (method, round(float(damping), 12) if method in DAMPED else None)
+
+    def _keep(self, key, value):
+        if len(self._maps) >= KEPT:
+            self._maps.pop(next(iter(self._maps)))
+        self._maps[key] = value
+
+    def _sweep(self, method, damping):
+        return sweep(self.arm, self.grid, self.theta0, method=method, damping=damping,
+                     tol=self.tol, max_iter=self.max_iter)
+
     def map_for(self, method, damping):
-        """The SweepMap of a method and lambda, solved once (lambda ignored by undamped methods)."""
-        key = (method, round(float(damping), 12) if method in DAMPED else None)
+        """The SweepMap of a method and lambda, solved once (lambda ignored by undamped methods);
+        a map being prefetched is waited for, not solved again."""
+        key = self._key(method, damping)
         if key not in self._maps:
-            if len(self._maps) >= KEPT:
-                self._maps.pop(next(iter(self._maps)))
-            self._maps[key] = sweep(self.arm, self.grid, self.theta0, method=method,
-                                    damping=damping, tol=self.tol, max_iter=self.max_iter)
-        return self._maps[key]
+            self._keep(key, self._sweep(method, damping))
+        found = self._maps[key]
+        if isinstance(found, Future):
+            found = self._maps[key] = found.result()
+        return found
+
+    def _prefetch(self, method, damping):
+        """Solve the maps one slider step either side of lambda in the background thread."""
+        if not self.prefetch or method not in DAMPED:
+            return
+        step = self.damping.step
+        for lam in (damping + step, damping - step):
+            lam = round(lam, 10)
+            key = self._key(method, lam)
+            if self.damping.min <= lam <= self.damping.max and key not in self._maps:
+                self._keep(key, _background().submit(self._sweep, method, lam))
 
     def update(self, damping=None, method=None, quantity=None):
         """Set any controls given, then redraw the map (solving it only if not solved before).
@@ -149,9 +197,8 @@ class LiveMap:
                     f"coloured by {' '.join(_label(self.quantity.value, self.max_iter).split())}; "
                     f"{self.summary}.")
         self.png = self._draw(map_image(self.result, self.quantity.value))
-        self.image.value = self.png
-        # no .tooltip on the image: ipywidgets 8.1's ImageView fails to render with one (it
-        # reads a description an Image does not have); the still and the status line carry it
+        self.image.value = img_html(self.png, self.alt)
+        self._prefetch(method, lam)
         return self.result
 
     def _draw(self, picture):
@@ -174,7 +221,5 @@ class LiveMap:
         """The current map as static HTML (an <img> with alt text), for viewers without a kernel
         (displaying .widget shows the same still where no kernel runs it)."""
         from IPython.display import HTML
-
-        from .alt_text import img_html
 
         return HTML(img_html(self.png, self.alt))
