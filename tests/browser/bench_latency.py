@@ -5,7 +5,9 @@
 A benchmark, not a test (speed is never asserted): it prints a table of p50/p95 for
   - demo x: the demo's (notebook 05) target-x slider moved one step -> the arm redrawn;
   - map lambda: the live map's (notebook 07: 128 x 128 targets) lambda slider moved one step
-    to a lambda not seen before -> the map redrawn;
+    to a lambda not seen before -> the map redrawn (the map was prefetched while idle);
+  - map no prefetch: the same on a live map with prefetch=False: every lambda solved when
+    asked for (what a jump of several steps costs);
   - demo method / map method: the method dropdown switched (after one warm-up round, so no
     compiling) -> the picture redrawn.
 Each sample is a real key press (selenium: arrow key on the focused slider handle) or a real
@@ -33,8 +35,11 @@ CELLS = [
     "arm = ik.planar_chain([1.0, 0.5, 0.25])  # as notebook 07\n"
     "live = ik.live_map.LiveMap(arm, grid_n=128, theta0=[0.3, 0.6, 0.6], damping=0.2, "
     "max_iter=100)\nlive.widget",
+    "cold = ik.live_map.LiveMap(arm, grid_n=128, theta0=[0.3, 0.6, 0.6], damping=0.2, "
+    "max_iter=100, prefetch=False)\ncold.widget  # every lambda solved when asked for",
 ]
-GOALS = {"demo x": 50, "map lambda": 150, "demo method": None, "map method": None}
+GOALS = {"demo x": 50, "map lambda": 150, "map no prefetch": None, "demo method": None,
+         "map method": None}
 
 # One recorder per widget output: start (event timeStamp) and drawn (performance.now()).
 INSTALL = """
@@ -128,6 +133,12 @@ def measure(driver, url, n):
     steps = min(n, 36)  # lambda 0.2 -> 2.0 in steps of 0.05: every one new
     rows["map lambda"] = [sample(driver, url, "live", lambda: press(driver, lam, Keys.ARROW_RIGHT))
                           for _ in range(steps)]
+    cold = output_of_cell(driver, 3)
+    driver.execute_script(INSTALL, "cold", cold)
+    lam = slider_handles(driver, cold)[0]
+    rows["map no prefetch"] = [
+        sample(driver, url, "cold", lambda: press(driver, lam, Keys.ARROW_RIGHT))
+        for _ in range(steps)]
     for key, output, names in (("demo", demo, ["pinv", "jt", "dls"]), ("live", live, ["jt", "dls"])):
         select = output.find_elements(By.CSS_SELECTOR, ".widget-dropdown select")[0]
         for name in names:  # warm-up round: compiles (and solves the map) once per method
@@ -140,13 +151,13 @@ def measure(driver, url, n):
 
 def table(rows, title):
     print(f"\n{title}")
-    print(f"| {'what':<12} | {'n':>3} | {'p50 ms':>7} | {'p95 ms':>7} | {'max ms':>7} | "
+    print(f"| {'what':<15} | {'n':>3} | {'p50 ms':>7} | {'p95 ms':>7} | {'max ms':>7} | "
           f"{'goal p95':>8} | {'decode+frame p50':>16} |")
-    print(f"|{'-' * 14}|{'-' * 5}|{'-' * 9}|{'-' * 9}|{'-' * 9}|{'-' * 10}|{'-' * 18}|")
+    print(f"|{'-' * 17}|{'-' * 5}|{'-' * 9}|{'-' * 9}|{'-' * 9}|{'-' * 10}|{'-' * 18}|")
     for name, samples in rows.items():
         t, last = np.asarray(samples).T
         goal = GOALS[name]
-        print(f"| {name:<12} | {len(t):>3} | {np.percentile(t, 50):>7.1f} | "
+        print(f"| {name:<15} | {len(t):>3} | {np.percentile(t, 50):>7.1f} | "
               f"{np.percentile(t, 95):>7.1f} | {t.max():>7.1f} | "
               f"{'< ' + str(goal) if goal else '':>8} | {np.percentile(last, 50):>16.1f} |")
 
