@@ -160,8 +160,21 @@ def test_targets_given_off_the_grid_are_rounded_to_it_like_the_slider(demo):
     assert (demo.x.value, demo.y.value) == (2.99, 0.44)
 
 
-def test_the_image_has_an_accessible_name_and_every_control_a_label(demo):
+def test_every_control_has_a_label_a_screen_reader_reads(demo):
+    import ipywidgets as w
+
     demo.update(x=1.0, y=1.5)
-    assert not demo.image.tooltip  # ipywidgets 8.1: an Image with a tooltip fails to render
-    for control in (demo.x, demo.y, demo.damping, demo.method, *demo.preset.children):
+    for control in (demo.method, *demo.preset.children):  # <select> with <label for>; buttons
         assert control.description.strip()
+    rows = demo.widget.children[1].children[:3]
+    for row, (name, label) in zip(rows, demo.labels.items()):
+        number, slider = row.children
+        assert slider is getattr(demo, name) and not slider.readout
+        # the number box carries the label (<label for> its <input>) and follows the slider
+        assert isinstance(number, w.BoundedFloatText) and number.description == label
+        assert (number.min, number.max, number.step) == (slider.min, slider.max, slider.step)
+        assert (row.link.source, row.link.target) == ((slider, "value"), (number, "value"))
+    demo.x.value = 3.5000000000000013  # as the browser's slider sends it: the box shows 3.5
+    assert rows[0].children[0].value == 3.5
+    rows[1].children[0].value = 0.25  # typed into the box: the slider moves, the demo solves
+    assert demo.y.value == 0.25 and "(3.50, 0.25)" in demo.alt

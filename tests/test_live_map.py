@@ -117,5 +117,7 @@ def test_the_map_has_a_fixed_css_size_rendered_at_hidpi_and_a_still():
     assert base64.b64encode(live.png).decode() in live.image.value
     assert "Workspace map" in live.alt and live.summary in live.alt
     assert 'alt="Workspace map' in data["text/html"]
-    for control in (live.damping, live.method, live.quantity):
+    for control in (live.method, live.quantity):
         assert control.description.strip()
+    number, slider = live.widget.children[0].children[0].children  # the lambda row
+    assert slider is live.damping and number.description == "λ (dls)"

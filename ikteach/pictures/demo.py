@@ -31,7 +31,7 @@ from matplotlib.colors import to_hex
 from matplotlib.figure import Figure
 
 from . import plot
-from .stills import png, still_html, with_still  # noqa: F401  (ik.demo.png, .still_html)
+from .stills import named_slider, png, still_html, with_still  # noqa: F401  (ik.demo.png)
 from ..core.chain import planar_chain, reach
 from ..core.solve import solve
 
@@ -182,7 +182,11 @@ class Demo:
         self.image = w.HTML(layout=w.Layout(width=f"{SIZE}px", max_width=FIT, height="auto",
                                             flex="0 1 auto"))
         self.text = w.Label(layout=w.Layout(width="auto"))
-        controls = w.VBox([self.x, self.y, self.damping, self.method, w.Label("presets"),
+        # each slider beside a number box that carries its label for screen readers
+        self.labels = {"x": "target x", "y": "target y", "damping": "λ (dls)"}
+        rows = [named_slider(w, getattr(self, name), text, style["description_width"])
+                for name, text in self.labels.items()]
+        controls = w.VBox([*rows, self.method, w.Label("presets"),
                            self.preset, self.text],
                           layout=w.Layout(width=f"{CONTROLS_WIDTH}px", max_width=FIT,
                                           flex="0 1 auto"))

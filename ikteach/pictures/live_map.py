@@ -103,7 +103,11 @@ class LiveMap:
         self.image = w.HTML(layout=w.Layout(width=f"{SIZE}px", max_width="calc(100% - 4px)",
                                             height="auto"))
         self.text = w.Label()
-        controls = w.HBox([self.damping, self.method, self.quantity],
+        from .stills import named_slider
+
+        lam = named_slider(w, self.damping, "λ (dls)", "50px")  # labelled for screen readers
+        lam.layout.width = "300px"
+        controls = w.HBox([lam, self.method, self.quantity],
                           layout=w.Layout(flex_flow="row wrap", max_width="100%"))
         self.widget = with_still(w.VBox)([controls, self.text, self.image],
                                          layout=w.Layout(max_width="100%"))

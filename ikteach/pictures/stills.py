@@ -4,7 +4,7 @@ A widget box made by with_still() displays as the live widget in a running noteb
 the same output, as a still (its current PNG with alt text and a caption) for GitHub, static
 HTML pages and a notebook opened before Run All: those show the richest output they can
 render, the still, instead of "VBox(...)" or "model not found". Also a fast PNG writer for
-widget images (redrawn on every slider move).
+widget images (redrawn on every slider move), and named_slider: a slider a screen reader names.
 """
 import base64
 import html
@@ -73,3 +73,26 @@ def with_still(box):
 
     BoxWithStill.__name__ = BoxWithStill.__qualname__ = f"{box.__name__}WithStill"
     return BoxWithStill
+
+
+def named_slider(w, slider, description, label_width):
+    """A slider row a screen reader can name. ipywidgets 8.1 ties a slider's description to
+    nothing (its handle is a <div role="slider"> without a name: Chromium's accessibility tree
+    reads "slider, 2.5"), while a number box's description is its <label for=...>. So the
+    row is a number box labelled `description` (the readout: typed into, or stepped with the
+    arrow keys) linked to the slider beside it, which keeps its tooltip and loses its own
+    description and readout. `w` is the ipywidgets module; the row's .link is the link."""
+    number = w.BoundedFloatText(value=slider.value, min=slider.min, max=slider.max,
+                                step=slider.step, description=description,
+                                tooltip=slider.tooltip, style={"description_width": label_width},
+                                layout=w.Layout(width=f"calc({label_width} + 70px)",
+                                                flex="0 0 auto"))
+    slider.description, slider.readout = "", False
+    slider.layout.flex, slider.layout.min_width = "1 1 auto", "60px"
+    row = w.HBox([number, slider], layout=w.Layout(width="auto", max_width="100%",
+                                                   align_items="center"))
+    # linked in the kernel, rounded: the browser's slider sends values such as
+    # 3.5000000000000013 (min + k * step in floats), which the box would show as they are
+    row.link = w.link((slider, "value"), (number, "value"),
+                      transform=(lambda v: round(v, 10), lambda v: v))
+    return row

@@ -159,10 +159,13 @@ def _run_all(lab, browser):
     return browser
 
 
+PICTURE = ".widget-html svg[role=img]"  # the demo's picture (an SVG in an HTML widget)
+
+
 def _demo(driver):
-    """The demo's image, status line and x slider handle, scrolled to the top of the page."""
+    """The demo's box, picture, status line and x slider handle, scrolled to the top."""
     try:
-        image = _wait_until(lambda: driver.find_elements(By.CSS_SELECTOR, ".widget-image"), 60,
+        image = _wait_until(lambda: driver.find_elements(By.CSS_SELECTOR, PICTURE), 60,
                             "the demo widget")[0]
     except AssertionError:
         cell = _js(driver, "return [...document.querySelectorAll('.jp-CodeCell')]"
@@ -182,12 +185,19 @@ def _demo(driver):
     return box, image, status, handle
 
 
+def _picture(box):
+    return box.find_element(By.CSS_SELECTOR, PICTURE)
+
+
+def _readout(box):  # the x slider's number box
+    return box.find_elements(By.CSS_SELECTOR, "input[type=number]")[0].get_property("value")
+
+
 def test_demo_is_crisp_and_fits_a_1280x720_screen(notebook):
     box, image, status, _ = _demo(notebook)
     _shot(notebook, "demo")
-    css_w, natural_w = _js(notebook, "return [arguments[0].getBoundingClientRect().width,"
-                                     " arguments[0].naturalWidth]", image)
-    assert css_w == 400 and natural_w == 800  # rendered at 2x its CSS size
+    css_w = _js(notebook, "return arguments[0].getBoundingClientRect().width", image)
+    assert css_w == 400 and image.tag_name == "svg"  # vector: sharp at any zoom
     top, bottom, right = _js(notebook, "const r = arguments[0].getBoundingClientRect();"
                                        " return [r.top, r.bottom, r.right]", box)
     panel_bottom = _js(notebook, "return document.querySelector('.jp-NotebookPanel .jp-Notebook')"
@@ -197,16 +207,46 @@ def test_demo_is_crisp_and_fits_a_1280x720_screen(notebook):
 
 def test_moving_the_x_slider_changes_the_status_line_and_the_image(notebook):
     box, image, status, handle = _demo(notebook)
-    readout = box.find_elements(By.CSS_SELECTOR, ".widget-readout")[0]
-    before = status.text, image.get_attribute("src"), image.screenshot_as_png, readout.text
+    before = status.text, image.get_attribute("outerHTML"), _picture(box).screenshot_as_png, _readout(box)
     ActionChains(notebook).click_and_hold(handle).move_by_offset(-90, 0).pause(0.3).release().perform()
     _wait_until(lambda: status.text != before[0], 30, "the status line to change")
     time.sleep(0.5)
     _shot(notebook, "demo-after-slider")
-    assert readout.text != before[3]
-    assert image.get_attribute("src") != before[1]
-    assert image.screenshot_as_png != before[2]
+    assert _readout(box) != before[3]  # the number box follows the slider
+    assert _picture(box).get_attribute("outerHTML") != before[1]
+    assert _picture(box).screenshot_as_png != before[2]
     assert "iterations" in status.text
+
+
+def _ax(driver, expression):
+    """(role, name) of the element `expression` yields, from Chromium's accessibility tree."""
+    found = driver.execute_cdp_cmd("Runtime.evaluate", {"expression": expression})["result"]
+    nodes = driver.execute_cdp_cmd("Accessibility.getPartialAXTree",
+                                   {"objectId": found["objectId"], "fetchRelatives": False})
+    node = nodes["nodes"][0]
+    return node.get("role", {}).get("value"), node.get("name", {}).get("value", "")
+
+
+def test_a_screen_reader_names_every_control_and_the_picture(notebook):
+    _demo(notebook)
+    driver = notebook
+    notebook.execute_cdp_cmd("Accessibility.enable", {})
+    box = f"document.querySelector('{PICTURE}').closest('.widget-hbox')"
+    spins = [_ax(driver, f"{box}.querySelectorAll('input[type=number]')[{i}]") for i in range(3)]
+    handles = [_ax(driver, f"{box}.querySelectorAll('.noUi-handle')[{i}]") for i in range(3)]
+    method = _ax(driver, f"{box}.querySelector('select')")
+    buttons = [_ax(driver, f"{box}.querySelectorAll('button')[{i}]") for i in range(3)]
+    picture = _ax(driver, f"{box}.querySelector('svg')")
+    print("\naccessibility tree:", spins, handles, method, buttons, picture[:1], picture[1][:60])
+    assert spins == [("spinbutton", "target x"), ("spinbutton", "target y"),
+                     ("spinbutton", "λ (dls)")]
+    # ipywidgets 8.1's noUiSlider handle: role slider, no name (nothing public sets one); its
+    # named number box comes just before it in the reading and tab order
+    assert [role for role, _ in handles] == ["slider"] * 3
+    assert method == ("combobox", "method")
+    assert buttons == [("button", "reachable"), ("button", "near the edge"),
+                       ("button", "unreachable")]
+    assert picture[0] == "image" and picture[1].startswith("Planar 3-link arm")
 
 
 def test_a_preset_button_acts_on_its_first_click(notebook):
@@ -214,8 +254,7 @@ def test_a_preset_button_acts_on_its_first_click(notebook):
     button = box.find_element(By.XPATH, ".//button[normalize-space()='unreachable']")
     button.click()
     _wait_until(lambda: "stalled" in status.text, 30, "the unreachable preset to apply")
-    readout = box.find_elements(By.CSS_SELECTOR, ".widget-readout")[0]
-    assert readout.text == "3.50"
+    assert _readout(box) == "3.5"
 
 
 def test_the_animation_play_button_advances_frames(notebook):
@@ -249,11 +288,11 @@ def test_no_stray_scrollbar_and_the_demo_fits_at_200_percent_zoom(notebook):
                               "mobile": False})
     try:
         time.sleep(1.0)
-        _js(notebook, "arguments[0].scrollIntoView({block: 'start'})", image)
+        _js(notebook, "arguments[0].scrollIntoView({block: 'start'})", _picture(box))
         time.sleep(0.5)
         _shot(notebook, "demo-200-percent")
         left, right = _js(notebook, "const r = arguments[0].getBoundingClientRect();"
-                                    " return [r.left, r.right]", image)
+                                    " return [r.left, r.right]", _picture(box))
         panel = _js(notebook, "const r = document.querySelector('.jp-NotebookPanel .jp-Notebook')"
                               ".getBoundingClientRect(); return [r.left, r.right]")
         assert panel[0] <= left and right <= panel[1], (left, right, panel)  # not clipped
