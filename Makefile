@@ -117,13 +117,14 @@ bench: $(STAMP)
 	@for b in benchmarks/*.py; do echo "== $$b"; $(BENCH_VENV)/bin/python $$b || exit 1; done
 
 # A real browser (Debian's chromium + chromium-driver, driven by selenium) runs notebook 05 in
-# JupyterLab, drags the demo's slider and plays an animation. Not part of `make test`.
+# JupyterLab, drags the demo's slider and plays an animation, then runs every lecture notebook
+# (no error, nothing clipped, alt text on every image). Not part of `make test`.
 SUDO := $(if $(filter 0,$(shell id -u)),,sudo)
 test-browser: $(STAMP)
 	@test -x /usr/bin/chromium -a -x /usr/bin/chromedriver || \
 	  { $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq chromium chromium-driver; }
 	$(PY) -m pip install --quiet "selenium>=4.20"
-	$(PY) -m pytest -v -p no:cacheprovider tests/browser/lab_05.py
+	$(PY) -m pytest -v -p no:cacheprovider tests/browser/lab_05.py tests/browser/lab_notebooks.py
 
 # Browser latency (a benchmark: prints p50/p95, asserts nothing): slider -> picture redrawn
 # in JupyterLab in headless Chromium. Run on an idle machine; not part of `make test`.

@@ -3,8 +3,8 @@ then checked as the room sees it: no error output, no clipped figure or widget, 
 with alt text that says something (not empty, not "Image"), every SVG picture named.
 
 Run with `make test-browser` (with lab_05.py); not collected by `make test`. One notebook at a
-time: its kernel is shut down before the next opens. A screenshot per notebook (1280x720,
-scrolled to its first picture) and a tall one of the whole notebook go to $BROWSER_SHOTS
+time: its kernel is shut down before the next opens. Two screenshots per notebook
+(1280x720: scrolled to its first picture, and to its last) go to $BROWSER_SHOTS
 (default: a new temporary folder, printed at the end of the run).
 """
 import os
@@ -17,12 +17,11 @@ import pytest
 pytest.importorskip("selenium.webdriver")
 from selenium.webdriver.common.by import By  # noqa: E402
 
-from labdriver import (ROOT, WIDTH, chromium, code_cell_count, jupyterlab,  # noqa: E402
+from labdriver import (ROOT, chromium, code_cell_count, jupyterlab,  # noqa: E402
                        run_all, shut_down_kernels)
 
 NOTEBOOKS = sorted(p.name for p in (ROOT / "notebooks").glob("[01][0-9]_*.ipynb"))
 RUN_ALL_TIMEOUT = 900  # s: the longest notebook on a busy 2-core machine
-TALL = 12000  # px: the tall screenshot's most height
 
 
 @pytest.fixture(scope="module")
@@ -87,29 +86,16 @@ return {errors, clipped, unnamed, pictures};
 
 
 def _screenshots(driver, shots, stem):
-    """The first picture in view at 1280x720, then the whole notebook in one tall shot."""
-    first = driver.execute_script(
-        "return document.querySelector('.jp-NotebookPanel:not(.lm-mod-hidden) "
-        ".jp-OutputArea :is(img, svg[role=img], .widget-box)')")
-    if first is not None:
-        driver.execute_script("arguments[0].scrollIntoView({block: 'start'})", first)
-        time.sleep(0.5)
-    driver.save_screenshot(str(shots / f"{stem}.png"))
-    height = driver.execute_script(
-        "return document.querySelector('.jp-NotebookPanel:not(.lm-mod-hidden) .jp-Notebook')"
-        ".scrollHeight")
-    # a taller screen for one shot (the window itself keeps its size)
-    driver.execute_cdp_cmd("Emulation.setDeviceMetricsOverride",
-                           {"width": WIDTH, "height": min(TALL, height + 200),
-                            "deviceScaleFactor": 1, "mobile": False})
-    try:
-        time.sleep(1.0)
-        driver.execute_script("document.querySelector('.jp-NotebookPanel:not(.lm-mod-hidden) "
-                              ".jp-Notebook').scrollTop = 0")
-        time.sleep(0.5)
-        driver.save_screenshot(str(shots / f"{stem}-whole.png"))
-    finally:
-        driver.execute_cdp_cmd("Emulation.clearDeviceMetricsOverride", {})
+    """Two 1280x720 views: the notebook's first picture (or widget) and its last."""
+    for which, suffix in ((0, ""), (-1, "-last")):
+        picture = driver.execute_script(
+            "const all = document.querySelectorAll('.jp-NotebookPanel:not(.lm-mod-hidden) "
+            ".jp-OutputArea :is(img, svg[role=img], .widget-box)');"
+            " return all.length ? all[arguments[0] < 0 ? all.length - 1 : 0] : null", which)
+        if picture is not None:
+            driver.execute_script("arguments[0].scrollIntoView({block: 'start'})", picture)
+            time.sleep(0.5)
+        driver.save_screenshot(str(shots / f"{stem}{suffix}.png"))
 
 
 @pytest.mark.parametrize("name", NOTEBOOKS)
