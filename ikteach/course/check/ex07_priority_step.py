@@ -1,12 +1,13 @@
 """Exercise 7: priority_step(J1, e1, J2, e2, damping) -> the secondary task in the primary's
 null space, J1+ e1 + N1 (J2 N1)+ (e2 - J2 J1+ e1), with damped pseudoinverses.
 
-Parts: the primary kept (J1 delta = J1 J1+ e1) 3, the secondary on regular cases 4, singular J1 3.
+Parts: the primary kept (J1 delta = J1 J1+ e1) 3, the secondary on regular cases 3, singular J1 2,
+no damping (lambda = 0, J1 singular or not: the exact pseudoinverses, finite) 2.
 """
 import numpy as np
 
 from ...core.priority import priority_step as _ref_step
-from .verdicts import (SEED, _Case, _Part, _as_array, _call, _check_callable, _close, _evaluate,
+from .verdicts import (SEED, _Case, _Fail, _Part, _as_array, _call, _check_callable, _close, _evaluate,
                        _fmt, _mismatch, _report, _shape_message)
 
 NUMBER = 7
@@ -18,6 +19,13 @@ REFERENCES = ("ikteach.core.priority:priority_step",
               "ikteach.core.priority:multilevel_step",
               "ikteach.core.priority:null_space_step",
 )
+
+
+_AT_ZERO = ("With damping = 0, A^T (A A^T + lambda^2 I)^-1 is A^T (A A^T)^-1, which does not exist "
+            "where A (here J1) is singular. At lambda = 0 the step uses the exact pseudoinverse: "
+            "write the damped one from the SVD, V diag(sigma_i / (sigma_i^2 + lambda^2)) U^T with "
+            "sigma_i below a small cut-off (e.g. 1e-10 sigma_max) dropped; it equals "
+            "A^T (A A^T + lambda^2 I)^-1 for lambda > 0 and np.linalg.pinv(A) at lambda = 0.")
 
 
 def _ref_priority(J1, e1, J2, e2, lam):
@@ -82,6 +90,21 @@ def _priority_cases():
     for k, (J1, e1, J2, e2, lam, note) in enumerate(singular):
         cases.append(_Case((J1, e1, J2, e2, lam), _priority_text(J1, e1, J2, e2, lam, note),
                            size=J1.size * 100 + k, tag="singular"))
+    # damping 0: A^T (A A^T)^-1 exists for J1 of full row rank, not for a singular J1
+    # (J2 N1 has full row rank in every one of these, so only J1 decides)
+    undamped = [
+        (np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]), np.array([0.5, -1.0]),
+         np.array([[0.0, 1.0, 1.0]]), np.array([1.0]), "no damping, J1 of full row rank"),
+        (np.array([[1.0, 2.0, 0.0, -1.0], [0.0, 1.0, 1.0, 0.5]]), np.array([0.3, 0.2]),
+         np.array([[1.0, 0.0, 1.0, 1.0]]), np.array([-0.4]), "no damping, J1 of full row rank"),
+        (np.zeros((2, 3)), np.array([1.0, -1.0]), np.array([[1.0, 0.0, 1.0]]), np.array([1.0]),
+         "no damping, singular: J1 = 0"),
+        (np.array([[1.0, 1.0, 0.0], [2.0, 2.0, 0.0]]), np.array([1.0, 0.5]),
+         np.array([[0.0, 1.0, 1.0]]), np.array([0.5]), "no damping, singular: rank-1 J1"),
+    ]
+    for k, (J1, e1, J2, e2, note) in enumerate(undamped):
+        cases.append(_Case((J1, e1, J2, e2, 0.0), _priority_text(J1, e1, J2, e2, 0.0, note),
+                           size=J1.size * 100 + 10 + k, tag="no damping"))
     for k in range(10):
         n = int(rng.integers(3, 7))
         m1, m2 = int(rng.integers(1, 3)), int(rng.integers(1, 3))
@@ -112,13 +135,17 @@ def _priority_parts(fn, name):
     def diagnose(got, want, case):
         if got.shape != want.shape:
             return _shape_message(name, got, want, case, " - one entry per joint")
-        if not np.all(np.isfinite(got)):
-            return ("NaN or inf where J1 (or J2 N1) is singular: use damped pseudoinverses, "
-                    "A^T (A A^T + lambda^2 I)^-1, which never divide by zero." + _mismatch(got, want, case))
-        for variant, why in _priority_variants(*case.args):
-            if _close(got, variant):
-                return why + _mismatch(got, want, case)
         J1, e1, _, _, lam = case.args
+        if not np.all(np.isfinite(got)):
+            if lam == 0:
+                return ("your step is NaN or inf at damping = 0 where J1 is singular. "
+                        + _AT_ZERO + _mismatch(got, want, case))
+            return ("NaN or inf where J1 (or J2 N1) is singular: use damped pseudoinverses, "
+                    "A^T (A A^T + lambda^2 I)^-1, which stay finite for damping > 0 (A A^T + "
+                    "lambda^2 I is then invertible)." + _mismatch(got, want, case))
+        for variant, why in _priority_variants(*case.args):
+            if _close(got, variant) and not (lam == 0 and "damping" in why):
+                return why + _mismatch(got, want, case)
         if not np.allclose(J1 @ got, J1 @ (_damped(J1, lam) @ e1), rtol=1e-6, atol=1e-8):
             return ("the primary task is disturbed: J1 delta_theta should equal J1 J1+ e1 "
                     "(the secondary may move only in J1's null space)." + _mismatch(got, want, case))
@@ -134,10 +161,23 @@ def _priority_parts(fn, name):
                     return diagnose(got, want, case)
         return check
 
+    def no_damping():
+        """damping = 0: the exact pseudoinverses, finite whether J1 is singular or not."""
+        _check_callable(fn, name)
+        for case in (c for c in cases if c.tag == "no damping"):
+            try:
+                got = result(case)
+            except _Fail as exc:
+                return f"at damping = 0 {exc}.\n  " + _AT_ZERO
+            want = _ref_priority(*case.args)
+            if not _close(got, want, rtol=1e-6, atol=1e-8):
+                problem = diagnose(got, want, case)
+                return problem if problem.startswith("your step is NaN") else "at damping = 0: " + problem
+
     def primary_kept():
         """J1 delta = J1 J1+ e1: the secondary adds nothing the primary sees (first order)."""
         _check_callable(fn, name)
-        for case in cases:
+        for case in (c for c in cases if c.tag != "no damping"):
             J1, e1, J2, e2, lam = case.args
             got = result(case)
             kept = (got.shape == (J1.shape[1],) and np.all(np.isfinite(got))
@@ -145,8 +185,8 @@ def _priority_parts(fn, name):
             if not kept:
                 return diagnose(got, _ref_priority(*case.args), case)
 
-    return [_Part("primary kept", 3, primary_kept), _Part("secondary", 4, against_reference("regular")),
-            _Part("singular", 3, against_reference("singular"))]
+    return [_Part("primary kept", 3, primary_kept), _Part("secondary", 3, against_reference("regular")),
+            _Part("singular", 2, against_reference("singular")), _Part("no damping", 2, no_damping)]
 
 
 def verdict(priority_step):
