@@ -85,16 +85,17 @@ def test_the_maps_one_step_either_side_are_prefetched_and_a_step_solves_nothing(
 
     monkeypatch.setattr(live_map, "sweep", sweep)
     live = live_map.LiveMap(ARM, grid_n=12, max_iter=50, damping=0.5)
-    for key in [("dls", 0.55), ("dls", 0.45)]:
-        live._maps[key].result()  # the background thread solved it
-    assert sorted(calls) == [("dls", 0.45), ("dls", 0.5), ("dls", 0.55)]
-    live.damping.value = 0.55  # one step: solved already
-    assert calls.count(("dls", 0.55)) == 1
-    ref = real(ARM, live.grid, live.theta0, method="dls", damping=0.55, tol=1e-3, max_iter=50)
+    assert calls == [("dls", 0.5)]  # displayed only (a Run All): nothing prefetched
+    live.damping.value = 0.55  # a move: solved, then 0.6 prefetched (0.5 is kept)
+    live._maps[("dls", 0.6)].result()  # the background thread solved it
+    assert calls == [("dls", 0.5), ("dls", 0.55), ("dls", 0.6)]
+    live.damping.value = 0.6  # one step: solved already
+    assert calls.count(("dls", 0.6)) == 1
+    ref = real(ARM, live.grid, live.theta0, method="dls", damping=0.6, tol=1e-3, max_iter=50)
     np.testing.assert_array_equal(live.result.iterations, ref.iterations)
-    live.update(method="jt")  # lambda unused: nothing prefetched
+    live.method.value = "jt"  # lambda unused: nothing prefetched
     live.damping.value = 1.0
-    assert [c for c in calls if c[0] == "jt"] == [("jt", 0.55)]
+    assert [c for c in calls if c[0] == "jt"] == [("jt", 0.6)]
 
 
 def test_the_map_has_a_fixed_css_size_rendered_at_hidpi_and_a_still():

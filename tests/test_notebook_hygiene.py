@@ -262,3 +262,13 @@ def test_a_widget_shows_a_still_where_no_kernel_runs_it(path):
             plain = "".join(data.get("text/plain", []))
             assert not re.match(r"(VBox|HBox|Box|Image|FloatSlider)\(", plain), \
                 f"{path.name} cell {i}: a widget without a still ({plain[:40]})"
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.relative_to(ROOT).as_posix())
+def test_every_notebook_links_the_one_notation_table(path):
+    nb = json.loads(path.read_text(encoding="utf-8"))
+    first = "".join(next(c for c in nb["cells"] if c["cell_type"] == "markdown")["source"])
+    link = re.search(r"\[notation table\]\(([^)#]+)#notation\)", first.splitlines()[-1]).group(1)
+    table = (path.parent / link).resolve()
+    assert table == ROOT / "notebooks" / "README.md"
+    assert '<a id="notation"></a>' in table.read_text(encoding="utf-8")

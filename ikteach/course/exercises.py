@@ -14,6 +14,7 @@ import re
 import sys
 from pathlib import Path
 
+from .notebook_header import NOTATION_LINE, notation_link, with_notation
 from .notebook_strip import strip_notebook
 
 BEGIN = "### BEGIN SOLUTION"
@@ -65,6 +66,9 @@ def template_from(solution):
             cell.execution_count = None
         elif cell.cell_type == "markdown" and BEGIN in cell.source:  # a written answer
             cell.source = strip_solutions(cell.source, ANSWER_PLACEHOLDER)
+    first_text = next((c for c in book.cells if c.cell_type == "markdown"), None)
+    if first_text is not None and NOTATION_LINE.search(first_text.source):  # linked from TEMPLATES
+        first_text.source = with_notation(first_text.source, notation_link(TEMPLATES / "template.ipynb"))
     book.metadata.setdefault("ikteach", {})["template"] = True
     return book
 

@@ -1,18 +1,20 @@
 """Every notebook's first code cell, and the Colab / Binder badges, from the course's home.
 
-    python -m ikteach.notebook_header            # rewrite what is out of date (make header)
-    python -m ikteach.notebook_header --check    # exit 1 and name what is out of date
+    python -m ikteach.course.notebook_header          # rewrite what is out of date (make header)
+    python -m ikteach.course.notebook_header --check  # exit 1 and name what is out of date
 
 The first code cell of each notebook (lecture notebooks, exercises, instructor solutions)
 starts with a generated block: on Colab only, pip-install the course package quietly (its
 dependencies bring what Colab lacks, e.g. pyvista). The rest of the cell (the notebook's own
 imports and `ik.notebook.setup()`) is kept. A notebook whose first code cell has no block
-gets one in front. The badges go into README.md (a generated table between markers) and
+gets one in front. The first Markdown cell ends with a link to the course's one notation table
+(notebooks/README.md#notation). The badges go into README.md (a generated table between markers) and
 into notebooks/README.md (the first column of each row naming a notebook, plus a generated
 table of exercises). Re-running changes nothing once everything is up to date.
 """
 import argparse
 import json
+import os
 import re
 import sys
 from pathlib import Path
@@ -42,6 +44,21 @@ def with_header(source, h):
     return header(h) + rest
 
 
+NOTATION = "Symbols: the course's one [notation table]({link}), one meaning each."
+NOTATION_LINE = re.compile(r"\n*Symbols: the course's one \[notation table\]\([^)]*\), one meaning each\.\s*\Z")
+
+
+def notation_link(path, root=ROOT):
+    """The notation table's address relative to the notebook at `path`."""
+    table = Path(root) / "notebooks" / "README.md"
+    return os.path.relpath(table, Path(path).parent).replace(os.sep, "/") + "#notation"
+
+
+def with_notation(source, link):
+    """A Markdown cell's source ending with the notation line (replaced if already there)."""
+    return NOTATION_LINE.sub("", source).rstrip("\n") + "\n\n" + NOTATION.format(link=link)
+
+
 def notebook_paths(root=ROOT):
     """Every notebook that gets the header: lecture, exercise and solution notebooks."""
     root = Path(root)
@@ -50,19 +67,30 @@ def notebook_paths(root=ROOT):
             + sorted((root / "instructor" / "solutions").glob("*.ipynb")))
 
 
-def update_notebook(path, h, write=True):
+def _edit(cell, edit):
+    """Apply edit to a cell's source; True when that changed it."""
+    source = "".join(cell["source"]) if isinstance(cell["source"], list) else cell["source"]
+    new = edit(source)
+    if new == source:
+        return False
+    cell["source"] = new.splitlines(keepends=True)
+    return True
+
+
+def update_notebook(path, h, write=True, root=ROOT):
     """Give a notebook file the current header; True when it was out of date."""
     text = Path(path).read_text(encoding="utf-8")
     nb = json.loads(text)
     code = [c for c in nb["cells"] if c["cell_type"] == "code"]
     if not code:
         raise ValueError(f"{path}: expected at least one code cell")
-    cell = code[0]
-    source = "".join(cell["source"]) if isinstance(cell["source"], list) else cell["source"]
-    new = with_header(source, h)
-    if new == source:
+    markdown = [c for c in nb["cells"] if c["cell_type"] == "markdown"]
+    changed = _edit(code[0], lambda src: with_header(src, h))
+    if markdown:
+        link = notation_link(path, root)
+        changed = _edit(markdown[0], lambda src: with_notation(src, link)) or changed
+    if not changed:
         return False
-    cell["source"] = new.splitlines(keepends=True)
     if write:
         Path(path).write_text(json.dumps(nb, indent=1, sort_keys=True, ensure_ascii=False) + "\n",
                               encoding="utf-8")
@@ -117,7 +145,7 @@ def update(root=ROOT, write=True):
     """Bring every header and badge up to date; returns the paths that were out of date."""
     root = Path(root)
     h = home(root / "pyproject.toml")
-    stale = [p for p in notebook_paths(root) if update_notebook(p, h, write)]
+    stale = [p for p in notebook_paths(root) if update_notebook(p, h, write, root)]
     readme = root / "README.md"
     text = readme.read_text(encoding="utf-8")
     new = replace_block(text, readme_table(h, root), "README.md")

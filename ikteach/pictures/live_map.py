@@ -9,8 +9,8 @@ The batch is compiled once per method; a new lambda is a traced number, so a cha
 one solve_batch over the grid and one small PNG render. Maps are kept per method and lambda
 (the JT map once: lambda does not change it), so moving lambda under JT, switching back to a
 method seen before or changing what is shown re-solves nothing. After each redraw the maps
-one slider step either side of lambda are solved in a background thread (prefetch=True),
-while the student looks: a step of the slider then finds its map solved (a jump further,
+one slider step either side of lambda are solved in a background thread (prefetch=True)
+once the student has moved a control, while they look: a step of the slider then finds its map solved (a jump further,
 or a move before the prefetch ends, solves or waits as before).
 
 The map is SIZE x SIZE CSS pixels (at most the page's width), rendered at HIDPI times that;
@@ -143,8 +143,11 @@ class LiveMap:
         self._background = self._canvas.copy_from_bbox(self._fig.bbox)
 
     def _changed(self, _change):
+        """A control moved in the browser: redraw, then prefetch the neighbours (only after a
+        move: a notebook's Run All, which only displays the map, solves nothing extra)."""
         if not self._holding:
             self.update()
+            self._prefetch(self.method.value, self.damping.value)
 
     def _key(self, method, damping):
         return (method, round(float(damping), 12) if method in DAMPED else None)
@@ -202,7 +205,6 @@ class LiveMap:
                     f"{self.summary}.")
         self.png = self._draw(map_image(self.result, self.quantity.value))
         self.image.value = img_html(self.png, self.alt)
-        self._prefetch(method, lam)
         return self.result
 
     def _draw(self, picture):
