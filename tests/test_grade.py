@@ -328,7 +328,7 @@ def one_student(tmp_path):
     return subs, tmp_path / "out" / "grades.csv"
 
 
-@pytest.mark.parametrize("breakage", ["reference not blocked", "runner missing"])
+@pytest.mark.parametrize("breakage", ["reference not blocked", "cells not run"])
 def test_a_failing_self_check_stops_before_grading_anyone(tmp_path, monkeypatch, capsys,
                                                           breakage):
     """The grader cannot grade here: exit status 3, why, and no CSV of wrong zeros."""
@@ -336,8 +336,9 @@ def test_a_failing_self_check_stops_before_grading_anyone(tmp_path, monkeypatch,
     if breakage == "reference not blocked":
         monkeypatch.setattr(ex02_jt_step, "REFERENCES", ())
         why = "a wrapper of ik.jt_step (exercise 2) got 10/10 (expected 0/10"
-    else:
-        monkeypatch.setattr(grade, "RUNNER", tmp_path / "no-such-runner.py")
+    else:  # the cells' jobs end without a report, as when the server cannot run them
+        monkeypatch.setattr(grade, "_run_cells", lambda book, sandbox, timeout: (
+            [], ["the notebook's run ended in cell 1 (exit status 1)"]))
         why = "a correct jt_step (exercise 2) got 10/10 (expected 10/10, without notes)"
     subs, out = one_student(tmp_path)
     flags = [] if SANDBOXED else ["--no-sandbox"]

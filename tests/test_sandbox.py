@@ -147,14 +147,17 @@ def test_the_probe_catches_a_sandbox_that_does_not_hold(monkeypatch):
 
 def test_judge_states_only_what_held():
     good = {"uid": 65534, "capabilities": 0, "read": [], "connected": False, "mounted": False,
-            "processes": 2, "userns_blocked": True}
+            "processes": 2, "userns_blocked": True,
+            "server": {"ptrace": False, "memory": False, "stopped": False}}
     lines = bwrap.judge(good, [], [Path("/srv/solutions")])
     assert any("no capabilities" in l for l in lines) and any("PID namespace" in l for l in lines)
     assert not any("user namespaces" in l for l in bwrap.judge(dict(good, userns_blocked=False),
                                                                 [], []))
     for bad, why in [({"uid": 0}, "uid 0"), ({"capabilities": 1 << 21}, "keeps capabilities"),
                      ({"read": ["/srv/solutions"]}, "read the hidden /srv/solutions"),
-                     ({"mounted": True}, "mount")]:
+                     ({"mounted": True}, "mount"),
+                     ({"server": {"ptrace": True, "memory": False, "stopped": False}},
+                      "reach the fork server"), ({"server": None}, "reach the fork server")]:
         with pytest.raises(SandboxUnavailable, match=why):
             bwrap.judge(dict(good, **bad), [], [])
     with pytest.raises(SandboxUnavailable, match="write in /work"):

@@ -7,14 +7,18 @@
 SUBMISSIONS_DIR holds one folder per student (the folder name is the student), each with that
 student's exercise notebooks (NN_name.ipynb, as handed out). For each notebook:
 
-1. its cells run in a kernel in a sandbox (ikteach.course.grading.sandbox: bubblewrap, an
-   unprivileged user without capabilities, no network, a read-only whitelist of the machine,
-   resource limits; where no sandbox works the grader refuses unless --no-sandbox), for its
-   errors and notes only - nothing it prints counts;
+1. its cells run in IPython's shell in a sandbox (ikteach.course.grading.sandbox: bubblewrap,
+   an unprivileged user without capabilities, no network, a read-only whitelist of the
+   machine, resource limits; where no sandbox works the grader refuses unless --no-sandbox),
+   for its errors and notes only - nothing it prints counts;
 2. the student's functions are taken from the notebook's source (top-level imports,
    definitions and assignments, by the AST) into a second sandboxed process, and ik.check runs
    in the grader's own process, calling them there through a pipe (each call under its time
    limit). So nothing a notebook does to modules, builtins, stdout or files changes a score.
+Both processes are fresh children of a fork server (grading/forkserver.py: one per sandbox and
+grading process, Python, JAX and ikteach imported once), which no student code ever ran in;
+after each, every process of the sandbox but the server is killed and what they wrote removed,
+so no notebook starts from a state another one touched.
    In that process ikteach's own answer to the exercise raises, the checker cannot be imported,
    and a graded name that is not a function written in the notebook gets 0 (grading/own_code.py).
 
@@ -35,10 +39,7 @@ import json
 import os
 import re
 import select
-import shutil
-import subprocess
 import sys
-import tempfile
 import time
 from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
@@ -51,7 +52,6 @@ from .grading.submissions import MAX_NOTEBOOK_BYTES, notebooks, read_notebook, s
 NOTEBOOK_TIMEOUT = 120.0  # seconds for all of a student's cells
 GRADE_TIMEOUT = 180.0     # seconds for the checks' worker: start-up and every call
 GRACE = 15.0              # the runner's own limit comes first; then it is killed from outside
-RUNNER = Path(__file__).with_name("grading") / "run_notebook.py"
 INSTRUCTOR = Path(__file__).resolve().parents[2] / "instructor"  # the solutions: hidden
 
 __all__ = ["grade_all", "grade_notebook", "grade_book", "exercise_number", "main",
@@ -71,39 +71,47 @@ def exercise_number(path, book):
     return None
 
 
-def _run_cells(book, work, sandbox, timeout):
-    """Run the notebook's cells in the sandbox; (error lines, notes) from the runner's report."""
-    run_dir = work / "run"
-    run_dir.mkdir()
-    copy = run_dir / "notebook.ipynb"  # the parsed, clean notebook: never the student's file
-    copy.write_text(json.dumps(book))
-    read_end, write_end = os.pipe()
+def _run_cells(book, sandbox, timeout):
+    """Run the notebook's cells in the sandbox; (error lines, notes) from the job's report."""
+    from .grading.servers import server_for
+
+    cells = []
+    for index, cell in enumerate(book["cells"]):
+        if isinstance(cell, dict) and cell.get("cell_type") == "code":
+            source = cell.get("source", "")
+            cells.append((index + 1, "".join(map(str, source)) if isinstance(source, list)
+                          else str(source)))
+    job = server_for(sandbox).job("cells", timeout, {"cells": cells})
+    report, ended = b"", None
     try:
-        process = sandbox.start([sys.executable, str(RUNNER), str(copy), f"{timeout:g}",
-                                 str(write_end)], run_dir, pass_fds=(write_end,),
-                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                                stderr=subprocess.DEVNULL)
-    finally:
-        os.close(write_end)
-    try:
-        status = process.wait(timeout + GRACE)  # killed there, whatever it does with signals
-    finally:
-        process.end()
-    report = b""
-    with os.fdopen(read_end, "rb") as pipe:
-        while select.select([pipe], [], [], 0)[0]:
-            chunk = os.read(pipe.fileno(), 1 << 16)
-            if not chunk or len(report) > 1 << 20:
+        deadline = time.monotonic() + timeout + GRACE  # the server kills it at `timeout`
+        while len(report) < 1 << 20 and time.monotonic() < deadline:
+            if not select.select([job], [], [], deadline - time.monotonic())[0]:
+                break
+            chunk = os.read(job.fileno(), 1 << 16)
+            if not chunk:
                 break
             report += chunk
-    try:
-        data = json.loads(report.decode(errors="replace").splitlines()[0])
-        return [str(e)[:400] for e in data["errors"]][:30], [str(n)[:400] for n in data["notes"]][:10]
-    except (ValueError, IndexError, KeyError, TypeError):
-        why = (f"it ran past the time limit of {timeout:g} s and was killed" if status is None
-               else f"exit status {status}")
-        return [], [f"the notebook's run ended without a report ({why}: a crash, or a CPU, "
-                    "memory or file-size limit)"]
+    finally:
+        ended = job.end(wait_for_exit=1.0)
+    errors, started, done = [], None, False
+    for line in report.decode(errors="replace").splitlines():
+        try:
+            message = json.loads(line)
+        except ValueError:
+            continue
+        if isinstance(message, dict):
+            errors += [str(message["error"])[:400]] if "error" in message else []
+            started = message.get("cell", started)
+            done = done or message.get("done") is True
+    if done:
+        return errors[:30], []
+    if ended.get("timed_out") or ended.get("status") is None:
+        return errors[:30], [f"cell {started} did not finish within the notebook's time limit "
+                             f"({timeout:g} s)"]
+    return errors[:30], [f"the notebook's run ended in cell {started} (exit status "
+                         f"{ended.get('status')}: a crash, os._exit, or a CPU, memory or "
+                         "file-size limit)"]
 
 
 def _answer_text(book):
@@ -120,16 +128,14 @@ def _answer_text(book):
     return "\n".join(texts)[:4000]
 
 
-def _check(number, book, work, sandbox, grade_timeout):
+def _check(number, book, sandbox, grade_timeout):
     """The verdict from ik.check in this process, on the student's functions in a worker."""
     from . import check
     from .grading.extract import code_cells
     from .grading.remote import ProcessEnded, Worker
 
-    check_dir = work / "check"
-    check_dir.mkdir()
     module = check.EXERCISES[number]
-    worker = Worker(code_cells(book), sandbox, check_dir, exercise=number,
+    worker = Worker(code_cells(book), sandbox, exercise=number,
                     references=module.REFERENCES, graded=module.FUNCTIONS, limit=grade_timeout)
     try:
         try:
@@ -162,12 +168,11 @@ def grade_book(name, book, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT
         result["message"] = ("not an exercise notebook (no ikteach exercise number in its "
                              "metadata or name)")
         return result
-    work = Path(tempfile.mkdtemp(prefix="nb-", dir=sandbox.work_root))
     started = time.monotonic()
     try:
         result["answer"] = _answer_text(book)
-        errors, notes = _run_cells(book, work, sandbox, timeout) if run_cells else ([], [])
-        verdict, check_notes = _check(number, book, work, sandbox, grade_timeout)
+        errors, notes = _run_cells(book, sandbox, timeout) if run_cells else ([], [])
+        verdict, check_notes = _check(number, book, sandbox, grade_timeout)
         result["notes"] = errors + notes + check_notes
         if verdict is None:
             result["message"] = "no grade: your code could not be loaded for the checks"
@@ -177,7 +182,6 @@ def grade_book(name, book, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT
     except Exception as exc:  # the grader's own failure on this notebook: report, go on
         result["message"] = f"could not grade the notebook: {type(exc).__name__}: {exc}"
     finally:
-        shutil.rmtree(work, ignore_errors=True)
         result["seconds"] = time.monotonic() - started
     return result
 

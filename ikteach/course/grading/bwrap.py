@@ -59,8 +59,9 @@ def python_paths(package):
     return [p for i, p in enumerate(kept) if not _inside(p, kept[:i])]
 
 
-def command(bwrap, flags, package, hidden, work):
-    """bwrap ... -- (argv follows): the whitelist, read-only; `work` the only writable folder."""
+def command(bwrap, flags, package, hidden, work, pid1=False):
+    """bwrap ... -- (argv follows): the whitelist, read-only; `work` the only writable folder;
+    `pid1`: argv is the PID namespace's init (the fork server) instead of bwrap's reaper."""
     args = [bwrap]
     for d in SYSTEM:
         if os.path.islink(d):
@@ -78,7 +79,7 @@ def command(bwrap, flags, package, hidden, work):
         if _inside(path, bound) and _is_dir(path):
             args += ["--tmpfs", str(path), "--remount-ro", str(path)]
     args += ["--remount-ro", "/", "--bind", str(work), str(work), "--chdir", str(work)]
-    return args + NAMESPACES + list(flags) + ["--"]
+    return args + NAMESPACES + (["--as-pid-1"] if pid1 else []) + list(flags) + ["--"]
 
 
 def working_flags(bwrap):
@@ -120,6 +121,9 @@ def judge(seen, escaped, hidden):
         failures.append("it could reach the grader's machine over the network")
     if seen.get("mounted"):
         failures.append("it could mount a file system")
+    server = seen.get("server")
+    if not isinstance(server, dict) or any(server.values()) or not server:
+        failures.append(f"it could reach the fork server that starts every notebook ({server})")
     if failures:
         raise SandboxUnavailable("bubblewrap runs, but its sandbox does not hold: "
                                  + "; ".join(failures) + ".")
@@ -131,7 +135,11 @@ def judge(seen, escaped, hidden):
              "solutions, submissions, the checker and the grader's output hidden: "
              + ", ".join(str(p) for p in hidden)]
     if seen.get("processes", 99) <= 4:
-        lines.append("own PID namespace: every process it starts ends with it")
+        lines.append("own PID namespace per grading process, whose init is the fork server: "
+                     "after each notebook's run and checks every other process in it is killed "
+                     "and what they wrote removed")
+    lines.append("cannot ptrace, read the memory of, or stop the fork server that starts every "
+                 "notebook in a fresh child")
     if seen.get("userns_blocked"):
         lines.append("cannot create user namespaces (so it cannot regain capabilities)")
     return lines

@@ -1,8 +1,7 @@
-"""The sandbox's start-up probe: run inside it as a script (like a student's code), it tries
-what a student's code must not be able to do and prints one JSON line of what it saw.
-
-    python probe.py '{"token": ..., "writes": [folders], "reads": [hidden folders], "port": N,
-                      "imports_only": false}'
+"""The sandbox's start-up probe: run inside it as a job of the fork server (as a student's
+code is), it tries what a student's code must not be able to do and answers what it saw.
+Request: {"token": ..., "writes": [folders], "reads": [hidden folders], "port": N,
+"imports_only": false}.
 
 The grader checks the writes on its own side too (a write into a private /tmp succeeds in
 here and escapes nowhere) and decides from this what its log may state (bwrap.judge).
@@ -11,8 +10,8 @@ import ctypes
 import ctypes.util
 import json
 import os
+import signal
 import socket
-import sys
 
 MS_REMOUNT, MS_BIND, CLONE_NEWUSER = 32, 4096, 0x10000000
 
@@ -75,6 +74,36 @@ def userns_blocked(libc):
     return os.waitpid(pid, 0)[1] != 0
 
 
+def job(requests_fd, replies_fd):
+    """The probe as a job of the fork server (forkserver.py): the request on one pipe, what it
+    saw on the other."""
+    with os.fdopen(requests_fd, "r") as requests:
+        request = json.loads(requests.readline())
+    with os.fdopen(replies_fd, "w") as replies:
+        replies.write(json.dumps(main(request)) + "\n")
+
+
+def server_held(libc):
+    """What the job could do to its fork server (PID 1 of the sandbox): each must be False."""
+    PTRACE_ATTACH, PTRACE_DETACH = 16, 17
+    held = {"ptrace": libc.ptrace(PTRACE_ATTACH, 1, None, None) == 0}
+    if held["ptrace"]:
+        libc.ptrace(PTRACE_DETACH, 1, None, None)
+    try:
+        with open("/proc/1/mem", "rb"):
+            held["memory"] = True
+    except OSError:
+        held["memory"] = False
+    try:
+        os.kill(1, signal.SIGSTOP)  # init ignores it from inside its namespace
+        with open("/proc/1/stat") as stat:
+            held["stopped"] = stat.read().rsplit(")", 1)[1].split()[0] in "Tt"
+        os.kill(1, signal.SIGCONT)
+    except OSError:
+        held["stopped"] = False
+    return held
+
+
 def main(request):
     libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
     package = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -84,16 +113,12 @@ def main(request):
                 "wrote": wrote(request["writes"], request["token"]),
                 "read": readable(request["reads"]), "connected": connected(request["port"]),
                 "mounted": mounted(libc, package), "userns_blocked": userns_blocked(libc),
-                "processes": sum(name.isdigit() for name in os.listdir("/proc"))}
+                "processes": sum(name.isdigit() for name in os.listdir("/proc")),
+                "server": server_held(libc)}
     try:
-        import ikteach  # noqa: F401 - what the checks' worker and the runner need
-        import ipykernel  # noqa: F401
-        import nbclient  # noqa: F401
+        import IPython  # noqa: F401 - what the cells and the checks' worker need
+        import ikteach  # noqa: F401
         seen["import_error"] = None
     except BaseException as exc:  # noqa: B036 - reported to the grader
         seen["import_error"] = f"{type(exc).__name__}: {exc}"[:500]
-    print(json.dumps(seen))
-
-
-if __name__ == "__main__":
-    main(json.loads(sys.argv[1]))
+    return seen

@@ -160,12 +160,11 @@ def _define(cells):
     return namespace, notes
 
 
-def worker():
-    requests = os.fdopen(os.dup(0), "r")
-    replies = os.fdopen(os.dup(1), "w")
-    null = os.open(os.devnull, os.O_RDWR)
-    for fd in (0, 1):
-        os.dup2(null, fd)  # the student's prints and input() see nothing of the protocol
+def worker(requests_fd, replies_fd):
+    """The worker's loop, in a child of the fork server (forkserver.py), on its job's pipes
+    (its stdin and stdout are /dev/null: the student's prints and input() see nothing)."""
+    requests = os.fdopen(requests_fd, "r", encoding="utf-8", errors="replace")
+    replies = os.fdopen(replies_fd, "w")
     from ikteach.core.solve import StopSolve
     from ikteach.course.grading import own_code
 
@@ -202,29 +201,26 @@ def worker():
 # --- the grader's side ------------------------------------------------------------------------------
 
 class Worker:
-    """One worker process for one notebook's code, started in a sandbox on first use.
-    exercise, references, graded: the exercise number, ikteach's functions to block (its check
-    module's REFERENCES) and the names the check grades; `limit`: seconds for the whole worker
-    (start-up and every call), applied from here: the process is then killed, whatever it does
-    with its signals."""
+    """One worker for one notebook's code: a fresh child of the sandbox's fork server
+    (servers.py), started by start(). exercise, references, graded: the exercise number,
+    ikteach's functions to block (its check module's REFERENCES) and the names the check
+    grades; `limit`: seconds for the whole worker (start-up and every call), applied from
+    outside the student's process: it is then killed, whatever it does with its signals."""
 
-    def __init__(self, cells, sandbox, work, exercise=None, references=(), graded=(),
+    def __init__(self, cells, sandbox, exercise=None, references=(), graded=(),
                  limit=STARTUP_LIMIT + CALL_LIMIT):
-        self.cells, self.sandbox, self.work = cells, sandbox, work
+        self.cells, self.sandbox = cells, sandbox
         self.setup = {"cells": cells, "exercise": exercise, "references": list(references),
                       "graded": list(graded)}
         self.limit, self.deadline = limit, None
         self.process, self.names, self.notes, self.foreign = None, [], [], {}
 
     def start(self):
-        import subprocess
+        from .servers import server_for
 
         self.deadline = time.monotonic() + self.limit
-        self.process = self.sandbox.start([sys.executable, "-m", "ikteach.course.grading.remote"],
-                                          self.work, stdin=subprocess.PIPE,
-                                          stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
+        self.process = server_for(self.sandbox).job("worker", self.limit + 5, self.setup)
         try:
-            self._write(self.setup)
             ready = self._read(STARTUP_LIMIT + STATEMENT_LIMIT * len(self.cells))
         except BaseException:
             self.end()
@@ -237,12 +233,10 @@ class Worker:
         return self
 
     def _write(self, message):
-        pipe = self.process.proc.stdin
-        pipe.write((json.dumps(message) + "\n").encode())
-        pipe.flush()
+        self.process.write((json.dumps(message) + "\n").encode())
 
     def _read(self, timeout):
-        fd, chunks, size = self.process.proc.stdout.fileno(), [], 0
+        fd, chunks, size = self.process.fileno(), [], 0
         while True:
             left = self.deadline - time.monotonic()
             ready, _, _ = select.select([fd], [], [], max(0.0, min(timeout, left)))
@@ -253,7 +247,7 @@ class Worker:
                 raise ProcessEnded(f"no answer within {timeout:g} s")
             chunk = os.read(fd, 1 << 20)
             if not chunk:
-                code = self.process.wait(5)
+                code = self.process.end(wait_for_exit=5)["status"]
                 raise ProcessEnded(f"the process running your code ended (exit status {code}:"
                                    " os._exit, a crash, or a CPU/memory limit)")
             chunks.append(chunk)
@@ -298,6 +292,3 @@ class Worker:
             self.process.end()
             self.process = None
 
-
-if __name__ == "__main__":
-    worker()

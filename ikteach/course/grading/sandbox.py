@@ -10,12 +10,16 @@ Always: own HOME, bare environment (BLAS kernel variables passed through, so tha
 numbers come from the same kernels as the grader's), resource limits (CPU time, address space,
 file size, no core files), its own process group (ended as a whole, from outside); a cap on
 processes where the cgroup v1 `pids` controller is writable, else RLIMIT_NPROC (not for root).
-`Sandbox.verify()` runs a probe inside and `report()` states only what the probe saw hold.
+Student code runs in jobs of a fork server started in the sandbox (servers.py, forkserver.py):
+one bubblewrap per server, a fresh child per notebook run or checks' worker, everything of a job
+killed and removed when it ends. `Sandbox.verify()` runs a probe as such a job and `report()`
+states only what the probe saw hold.
 """
 import dataclasses
 import json
 import os
 import secrets
+import select
 import shutil
 import signal
 import socket
@@ -31,7 +35,6 @@ from .bwrap import SandboxUnavailable
 __all__ = ["Limits", "Process", "Sandbox", "SandboxUnavailable", "refusal"]
 
 LAUNCH = Path(__file__).with_name("_launch.py")
-PROBE = Path(__file__).with_name("probe.py")
 CGROUP_PIDS = Path("/sys/fs/cgroup/pids")
 # BLAS/LAPACK kernel and thread settings: the student's process must compute with the same
 # kernels as the grader's (another OpenBLAS kernel changes the last bits of an SVD)
@@ -110,10 +113,11 @@ class Sandbox:
         shutil.rmtree(self.work_root, ignore_errors=True)
 
     def verify(self):
-        """Run the probe in the sandbox; what it saw hold becomes report()'s lines. Raises
-        SandboxUnavailable when bubblewrap runs but does not isolate, or when the grader's own
-        Python or ikteach cannot run in the sandbox."""
-        work = Path(tempfile.mkdtemp(prefix="probe-", dir=self.work_root))
+        """Run the probe as a job of the fork server, as a student's code runs; what it saw
+        hold becomes report()'s lines. Raises SandboxUnavailable when bubblewrap runs but does
+        not isolate, or when the grader's own Python or ikteach cannot run in the sandbox."""
+        from .servers import ServerFailed, server_for
+
         server = socket.socket()
         server.bind(("127.0.0.1", 0))
         server.listen()
@@ -122,16 +126,20 @@ class Sandbox:
                           tempfile.gettempdir()} | {str(p.parent) for p in self.hidden})
         request = {"token": token, "writes": outside, "reads": [str(p) for p in self.hidden],
                    "port": server.getsockname()[1], "imports_only": not self.bwrap}
+        out = b""
         try:
-            process = self.start([sys.executable, str(PROBE), json.dumps(request)], work,
-                                 stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                 stderr=subprocess.STDOUT)
+            job = server_for(self).job("probe", 120, request)
             try:
-                out = process.proc.communicate(timeout=120)[0].decode(errors="replace")
-            except subprocess.TimeoutExpired:
-                out = "(no answer within 120 s)"
+                while select.select([job], [], [], 120)[0]:
+                    chunk = os.read(job.fileno(), 1 << 16)
+                    if not chunk:
+                        break
+                    out += chunk
             finally:
-                process.end()
+                job.end(wait_for_exit=5)
+        except ServerFailed as exc:
+            raise SandboxUnavailable("the grader's Python or packages do not work in the "
+                                     f"sandbox: {exc}") from None
         finally:
             server.close()
         marker = f".ikteach-probe-{token}"
@@ -139,7 +147,7 @@ class Sandbox:
         for d in escaped:
             os.unlink(os.path.join(d, marker))
         try:
-            seen = json.loads(out.strip().splitlines()[-1])
+            seen = json.loads(out.decode(errors="replace").strip().splitlines()[-1])
         except (ValueError, IndexError):
             raise SandboxUnavailable(f"the sandbox self-check could not run Python "
                                      f"({sys.executable}) in the sandbox: {out[-600:]}") from None
@@ -188,8 +196,9 @@ class Sandbox:
         (path / "pids.max").write_text(str(self.limits.processes))
         return path
 
-    def command(self, argv, work, cgroup):
-        """The full command line: launcher (limits), then bwrap (if any), then argv."""
+    def command(self, argv, work, cgroup, pid1=False):
+        """The full command line: launcher (limits), then bwrap (if any), then argv (`pid1`:
+        as the init of its PID namespace)."""
         lim = self.limits
         nproc = lim.processes if (not self.root and not self.cgroup) else 0
         launch = [sys.executable, "-S", str(LAUNCH), str(lim.cpu_seconds),
@@ -198,7 +207,7 @@ class Sandbox:
         if not self.bwrap:
             return launch + list(argv)
         return launch + _bwrap.command(self.bwrap, self.flags, self.package, self.hidden,
-                                       Path(work)) + list(argv)
+                                       Path(work), pid1) + list(argv)
 
     def environment(self, work):
         home = Path(work) / "home"
@@ -210,10 +219,10 @@ class Sandbox:
         env.update({k: os.environ[k] for k in PASSED_THROUGH if k in os.environ})
         return env
 
-    def start(self, argv, work, **popen):
+    def start(self, argv, work, pid1=False, **popen):
         """A running Process for argv in `work` (a folder the caller created)."""
         cgroup = self._cgroup_dir()
-        proc = subprocess.Popen(self.command(argv, work, cgroup), cwd=work,
+        proc = subprocess.Popen(self.command(argv, work, cgroup, pid1), cwd=work,
                                 env=self.environment(work), **popen)
         return Process(proc, cgroup)
 

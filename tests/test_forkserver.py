@@ -1,0 +1,100 @@
+"""The fork server (ikteach/course/grading/forkserver.py) starts every notebook's run and checks
+in a fresh child of one long-lived process per sandbox: what one notebook does must not reach
+the next one's state or mark. A notebook that writes files (its HOME, TMPDIR, working folder,
+/tmp, /dev/shm, /dev), leaves a daemon (setsid + fork), patches numpy, sets an environment
+variable and makes a SysV shared memory segment is graded; then a plain correct one in the same
+sandbox gets 10/10 and a worker of the same server sees none of it.
+
+With bubblewrap all of it holds. Without it (--no-sandbox: no namespaces) the shared places
+are the machine's own and are not touched here; the rest holds there too.
+"""
+import pytest
+
+from ikteach.course import grade
+from ikteach.course.grading import selfcheck, servers
+from ikteach.course.grading.remote import Worker
+from ikteach.course.grading.sandbox import Sandbox, SandboxUnavailable
+
+
+def _sandbox():
+    try:
+        return Sandbox([])
+    except SandboxUnavailable:
+        return Sandbox([], unsandboxed=True)
+
+
+SHARED = ["/tmp", "/dev/shm", "/dev"]
+ATTACK = '''\
+import ctypes, os, subprocess, sys
+import numpy as np
+def _attack(shared, chmod_tmp):
+    for folder in [os.environ["HOME"], os.environ["TMPDIR"], os.getcwd()] + shared:
+        with open(os.path.join(folder, "left-by-A"), "w") as handle:
+            handle.write("A")
+    subprocess.Popen([sys.executable, "-c", "import os, time\\nif os.fork(): os._exit(0)\\n"
+                      "while True: time.sleep(0.05)", "left-by-A"], start_new_session=True)
+    os.environ["LEFT_BY_A"] = "1"
+    np.asarray = lambda a, *args, **kwargs: np.zeros_like(np.array(a, dtype=float))
+    if shared:
+        ctypes.CDLL(None).shmget(0x1EE7, 4096, 0o1666)
+    if chmod_tmp:
+        os.chmod("/tmp", 0o700)  # cannot be put back by removing files: a fresh server
+    return True
+'''
+LOOK = '''\
+import os
+import numpy as np
+def look(shared):
+    places = [os.environ["HOME"], os.environ["TMPDIR"], os.getcwd()] + shared
+    procs = []
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            with open(f"/proc/{pid}/cmdline", "rb") as handle:
+                procs += [pid] if b"left-by-A" in handle.read() else []
+        except OSError:
+            pass
+    with open("/proc/sysvipc/shm") as table:  # keys in decimal: 0x1EE7 is 7911
+        shm = sum(line.split()[0] == "7911" for line in table) if shared else 0
+    return {"files": [p for p in places if os.path.exists(os.path.join(p, "left-by-A"))],
+            "processes": procs, "env": "LEFT_BY_A" in os.environ, "shm": shm,
+            "asarray": float(np.asarray([2.0])[0]), "tmp": oct(os.stat("/tmp").st_mode & 0o777)}
+'''
+
+
+def attacked_book(shared, chmod_tmp):
+    """Exercise 2's known-good answer, preceded by the attack (in the cells and the checks)."""
+    book = selfcheck.book(selfcheck.GOOD)
+    call = f"_done = _attack({shared!r}, {chmod_tmp!r})\n"
+    book["cells"].insert(1, dict(book["cells"][0], source=ATTACK + call))
+    return book
+
+
+@pytest.mark.parametrize("chmod_tmp", [False, True])
+def test_what_a_notebook_leaves_does_not_reach_the_next(chmod_tmp):
+    sandbox = _sandbox()
+    shared = SHARED if sandbox.bwrap else []
+    if chmod_tmp and not sandbox.bwrap:
+        sandbox.close()
+        pytest.skip("without a sandbox /tmp is the machine's own")
+    try:
+        first = servers.server_for(sandbox)
+        attacked = grade.grade_book("a.ipynb", attacked_book(shared, chmod_tmp), 30, 60, sandbox)
+        assert attacked["notes"] == [] and attacked["score"] < 10, attacked  # its own asarray
+        replaced = servers.server_for(sandbox) is not first
+        after = grade.grade_book("b.ipynb", selfcheck.book(selfcheck.GOOD), 30, 60, sandbox)
+        assert after["score"] == 10 and after["notes"] == [], after
+        worker = Worker([(1, LOOK)], sandbox).start()
+        try:
+            seen = worker.call("look", [shared])
+        finally:
+            worker.end()
+        assert seen == {"files": [], "processes": [], "env": False, "shm": 0, "asarray": 2.0,
+                        "tmp": seen["tmp"]}, seen
+        if sandbox.bwrap:
+            assert seen["tmp"] != oct(0o700), seen
+            # /tmp's mode cannot be put back by removing files: that server was replaced
+            assert replaced == chmod_tmp
+    finally:
+        servers.close_all()
+        sandbox.close()
+
