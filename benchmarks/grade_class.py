@@ -4,7 +4,10 @@
 
 Each student folder holds exercises 1..6: the instructor's solution for some, the untouched
 template for others (a fixed pattern, so every run grades the same class). Prints the wall
-time, seconds per notebook and the score totals (which the pattern fixes).
+time (start-up, probe and self-check included), seconds per notebook and the score totals
+(which the pattern fixes), and a reference loop's time before and after (this shared 2-core
+machine's speed drifts: compare runs only with similar loop times). `--label` names the row,
+e.g. to compare two checkouts: PYTHONPATH=/other/checkout ... --label before.
 """
 import argparse
 import csv
@@ -34,12 +37,21 @@ def build_class(folder, students, exercises):
     return len(books), solved
 
 
+def loop_seconds():
+    """Seconds for a fixed pure-Python loop (10 million squares): this machine's speed now."""
+    t0 = time.perf_counter()
+    sum(i * i for i in range(10_000_000))
+    return time.perf_counter() - t0
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--students", type=int, default=30)
     ap.add_argument("--exercises", type=int, default=6)
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--label", default="")
     args = ap.parse_args()
+    loop_before = loop_seconds()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         n_books, solved = build_class(tmp / "class", args.students, args.exercises)
@@ -54,11 +66,13 @@ def main():
         rows = list(csv.DictReader(out.open()))
     notebooks = args.students * n_books
     total = sum(float(r["total"]) for r in rows)
-    print(f"| students | notebooks | jobs | wall          | s per notebook | marks (expected) |")
-    print(f"|----------|-----------|------|---------------|----------------|------------------|")
-    print(f"| {args.students:8d} | {notebooks:9d} | {args.jobs:4d} | "
+    print("| run        | students | notebooks | jobs | wall          | s per notebook | "
+          "marks (expected) | loop s before/after |")
+    print("|------------|----------|-----------|------|---------------|----------------|"
+          "------------------|---------------------|")
+    print(f"| {args.label:<10} | {args.students:8d} | {notebooks:9d} | {args.jobs:4d} | "
           f"{int(wall // 60):3d} min {wall % 60:4.1f} s | {wall / notebooks:14.2f} | "
-          f"{total:.0f} ({solved * 10}) |")
+          f"{total:>8.0f} ({solved * 10}) | {loop_before:9.2f} / {loop_seconds():.2f} |")
 
 
 if __name__ == "__main__":
