@@ -15,19 +15,20 @@ student's exercise notebooks (NN_name.ipynb, as handed out). For each notebook:
    definitions and assignments, by the AST) into a second sandboxed process, and ik.check runs
    in the grader's own process, calling them there through a pipe (each call under its time
    limit). So nothing a notebook does to modules, builtins, stdout or files changes a score.
+   In that process ikteach's own answer to the exercise raises, the checker cannot be imported,
+   and a graded name that is not a function written in the notebook gets 0 (grading/own_code.py).
 Both processes are fresh children of a fork server (grading/forkserver.py: one per sandbox and
 grading process, Python, JAX and ikteach imported once), which no student code ever ran in;
 after each, every process of the sandbox but the server is killed and what they wrote removed,
 so no notebook starts from a state another one touched.
-   In that process ikteach's own answer to the exercise raises, the checker cannot be imported,
-   and a graded name that is not a function written in the notebook gets 0 (grading/own_code.py).
 
 Before anyone is graded the sandbox is probed (the log states only what the probe saw hold)
 and a known-good answer must get full marks (grading/selfcheck.py); if either fails the grader
 stops with a non-zero exit status. The submissions folder is not trusted (grading/submissions.py):
 a symlink, FIFO, directory or malformed notebook costs only its student's marks, with a reason
 in the CSV's `notes`. Each notebook's cells get --timeout seconds and its checks
---grade-timeout, both enforced from outside (the process group is killed).
+--grade-timeout, both enforced from outside the student's process (the fork server kills every
+process of the job; the grader kills the whole sandbox if the server does not answer).
 
 Writes one CSV row per student (ex1..ex7, total, sandbox, notes) and a feedback file per student
 (FEEDBACK/<student>.txt, by default a `feedback` folder next to the CSV); the log starts with
@@ -51,7 +52,7 @@ from .grading.submissions import MAX_NOTEBOOK_BYTES, notebooks, read_notebook, s
 
 NOTEBOOK_TIMEOUT = 120.0  # seconds for all of a student's cells
 GRADE_TIMEOUT = 180.0     # seconds for the checks' worker: start-up and every call
-GRACE = 15.0              # the runner's own limit comes first; then it is killed from outside
+GRACE = 15.0              # the fork server's kill comes first; then the grader ends it all
 INSTRUCTOR = Path(__file__).resolve().parents[2] / "instructor"  # the solutions: hidden
 
 __all__ = ["grade_all", "grade_notebook", "grade_book", "exercise_number", "main",
@@ -106,6 +107,9 @@ def _run_cells(book, sandbox, timeout):
             done = done or message.get("done") is True
     if done:
         return errors[:30], []
+    if started is None:
+        return errors[:30], [f"the notebook's run ended before its first cell (exit status "
+                             f"{ended.get('status')})"]
     if ended.get("timed_out") or ended.get("status") is None:
         return errors[:30], [f"cell {started} did not finish within the notebook's time limit "
                              f"({timeout:g} s)"]

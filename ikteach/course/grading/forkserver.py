@@ -266,6 +266,7 @@ def main(argv):
                                  f"{type(exc).__name__}: {exc}"[:500]}).encode())
         return 1
     server.send(hello)
+    os.dup2(null, 2)  # from here on nothing is read from its stderr: never let it fill a pipe
     server.serve()
     return 0
 

@@ -1,7 +1,7 @@
 """The student's functions in a separate, sandboxed worker process; the checks call them
 through proxies and compute the marks in the grader's own process.
 
-The worker (`python -m ikteach.course.grading.remote`) executes only the kept top-level statements
+The worker (worker(), in a fresh child of the fork server) executes only the kept top-level statements
 (imports, definitions, assignments - see extract.py) of the student's code cells, then answers
 calls: one JSON line per request and per reply on its own pipes (its stdout and stdin are
 /dev/null to the student's code). Values cross as JSON (numbers, strings, lists, dicts, arrays
