@@ -54,6 +54,12 @@ def _libc():
     return ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
 
 
+def _prctl(libc, option, value):
+    """Linux's prctl; elsewhere (only ever unsandboxed) there is nothing to set."""
+    if hasattr(libc, "prctl"):
+        libc.prctl(option, value, 0, 0, 0)
+
+
 def _state(roots, keep):
     """{path: (mode, uid, inode)} of everything under `roots` (not following links), except
     what lies inside `keep` (the server's own folder)."""
@@ -103,10 +109,10 @@ class Server:
         self.baseline = None
 
     def start(self):
-        self.libc.prctl(PR_SET_DUMPABLE, 0, 0, 0, 0)
+        _prctl(self.libc, PR_SET_DUMPABLE, 0)
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         if not self.pid1:  # unsandboxed: orphans of a job come back here, to be ended
-            self.libc.prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0)
+            _prctl(self.libc, PR_SET_CHILD_SUBREAPER, 1)
         if self.sandboxed:
             if not self.pid1:
                 raise RuntimeError("the fork server must be PID 1 of its sandbox")
@@ -204,8 +210,9 @@ class Server:
 
 
 def _children():
+    """This process's live children (by /proc; none found where there is no /proc)."""
     me, found = str(os.getpid()), []
-    for name in os.listdir("/proc"):
+    for name in os.listdir("/proc") if os.path.isdir("/proc") else []:
         if name.isdigit():
             try:
                 with open(f"/proc/{name}/stat") as handle:
@@ -225,7 +232,7 @@ def _child(kind, fds, job, control):
         for number in (signal.SIGCHLD, signal.SIGTERM, signal.SIGALRM):
             signal.signal(number, signal.SIG_DFL)
         signal.signal(signal.SIGINT, signal.default_int_handler)
-        _libc().prctl(PR_SET_DUMPABLE, 1, 0, 0, 0)  # an ordinary process, as a kernel was
+        _prctl(_libc(), PR_SET_DUMPABLE, 1)  # an ordinary process, as a kernel was
         os.close(control)
         high = [fcntl.fcntl(fd, fcntl.F_DUPFD, 100) for fd in fds]  # out of 3 and 4's way
         requests, replies = os.dup2(high[0], 3), os.dup2(high[1], 4)

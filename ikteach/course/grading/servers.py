@@ -52,7 +52,11 @@ class Server:
     def __init__(self, sandbox):
         self.sandbox, self.jobs, self.broken = sandbox, 0, False
         self.dir = Path(tempfile.mkdtemp(prefix="server-", dir=sandbox.work_root))
-        ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+        try:
+            ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+        except (OSError, AttributeError) as exc:  # e.g. macOS: no SEQPACKET Unix sockets
+            raise ServerFailed(f"this system cannot run the fork server ({exc}): grade on "
+                               "Linux (README, Grading)") from None
         try:
             self.process = sandbox.start(
                 [sys.executable, "-m", "ikteach.course.grading.forkserver", str(theirs.fileno()),
