@@ -46,17 +46,19 @@ def test_the_checker_cannot_be_imported_after_block_checker():
     out = run("""
         import ikteach as ik
         from ikteach.course.grading import own_code
+        import ikteach.course.grading.selfcheck
         ik.check  # loaded before, as in a kernel
         own_code.block_checker()
         for attempt in ("ik.check", "__import__('ikteach.course.check')",
-                        "__import__('ikteach.course.check.ex06_singularity_study')"):
+                        "__import__('ikteach.course.check.ex06_singularity_study')",
+                        "__import__('ikteach.course.grading.selfcheck').course.grading.selfcheck.GOOD"):
             try:
                 eval(attempt)
                 print(attempt, "imported")
             except (ImportError, AttributeError) as exc:
                 print(attempt, "refused", type(exc).__name__)
         """)
-    assert "imported" not in out and out.count("refused") == 3, out
+    assert "imported" not in out and out.count("refused") == 4, out
 
 
 DEFINITIONS = [

@@ -7,7 +7,7 @@ student's statements.
   a default argument, a decorator, a class attribute, jax.jit's __wrapped__, a solver's method
   table) reaches the stub, and a wrapper of it gets nothing from it.
 - block_checker(): the checker (ikteach.course.check: the instant checks and their reference
-  answers) cannot be imported in the worker; in the sandbox its folder is empty as well.
+  answers; the grader's self-check, which holds a correct answer) cannot be imported in the worker; in the sandbox its folder is empty as well.
 - foreign(namespace, names): which graded names are not functions written in the notebook
   (their code must come from a `<cell N>`), and why - for the feedback: the worker runs the
   student's code, so what holds is the blocked references (their code is gone from this
@@ -20,7 +20,8 @@ import sys
 import types
 
 CELL = "<cell "
-CHECKER = ("ikteach.course.check", "ikteach.course.grade")
+CHECKER = ("ikteach.course.check", "ikteach.course.grade",
+           "ikteach.course.grading.selfcheck")  # the self-check holds a correct exercise 2
 
 
 class ReferenceBlocked(BaseException):
@@ -75,6 +76,9 @@ class _NoChecker:
 def block_checker():
     for name in [n for n in sys.modules if n.startswith(CHECKER)]:
         del sys.modules[name]
+        parent, _, child = name.rpartition(".")
+        if parent in sys.modules:  # e.g. ikteach.course.grading.selfcheck as an attribute
+            sys.modules[parent].__dict__.pop(child, None)
     sys.meta_path.insert(0, _NoChecker())
     ikteach = sys.modules.get("ikteach")
     if ikteach is not None:
