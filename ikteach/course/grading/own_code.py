@@ -77,8 +77,9 @@ def block_checker():
     for name in [n for n in sys.modules if n.startswith(CHECKER)]:
         del sys.modules[name]
         parent, _, child = name.rpartition(".")
-        if parent in sys.modules:  # e.g. ikteach.course.grading.selfcheck as an attribute
-            sys.modules[parent].__dict__.pop(child, None)
+        package = sys.modules.get(parent)
+        if package is not None:  # e.g. ikteach.course.grading's attribute selfcheck
+            package.__dict__.pop(child, None)
     sys.meta_path.insert(0, _NoChecker())
     ikteach = sys.modules.get("ikteach")
     if ikteach is not None:
