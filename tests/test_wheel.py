@@ -162,7 +162,10 @@ def test_wheel_in_a_clean_venv_solves_plots_and_renders(dist, tmp_path):
 def _colab_python():
     """A Python 3.12 like Colab's, if this machine has one (else the tests' own Python)."""
     pyenv = Path(os.environ.get("PYENV_ROOT", Path.home() / ".pyenv")) / "versions"
-    candidates = sorted(str(p) for p in pyenv.glob(f"{COLAB_PYTHON}.*/bin/python"))
+    try:
+        candidates = sorted(str(p) for p in pyenv.glob(f"{COLAB_PYTHON}.*/bin/python"))
+    except OSError:  # e.g. another user's pyenv, not readable by this one
+        candidates = []
     found = shutil.which(f"python{COLAB_PYTHON}")
     if found and "shims" not in found:  # a pyenv shim refuses versions not selected
         candidates.append(found)
