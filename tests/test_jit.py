@@ -39,14 +39,26 @@ def test_an_unknown_option_is_refused_not_fatal():
     assert xla.supported({})
 
 
+def _jaxlib_version():
+    import jaxlib
+
+    return tuple(int(v) for v in jaxlib.__version__.split(".")[:2])
+
+
 def test_the_locked_jaxlib_takes_the_fast_compile_option():
-    assert xla.supported(xla.FAST_COMPILE)
-    assert xla.compiler_options() == xla.FAST_COMPILE
+    """The lock's jaxlib for Python 3.11 (0.10) knows the option; its jaxlib for Python >= 3.12
+    (0.12) does not, and then every program compiles as plain jax.jit does."""
+    if _jaxlib_version() < (0, 12):
+        assert xla.supported(xla.FAST_COMPILE)
+        assert xla.compiler_options() == xla.FAST_COMPILE
+    else:
+        assert not xla.supported(xla.FAST_COMPILE) and xla.compiler_options() is None
 
 
 def test_with_and_without_the_options_every_solve_ends_the_same():
     fast, plain = run("on"), run("off")
-    assert fast["options"] == xla.FAST_COMPILE and plain["options"] is None
+    on = xla.FAST_COMPILE if xla.supported(xla.FAST_COMPILE) else None  # see the test above
+    assert fast["options"] == on and plain["options"] is None
     for method in ("dls", "jt", "sdls", "ccd"):
         (bs, bi, bt, rs, ri, rt), (ps, pi, pt, qs, qi, qt) = fast[method], plain[method]
         assert bs == ps and bi == pi and (rs, ri) == (qs, qi), method
