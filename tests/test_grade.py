@@ -23,7 +23,7 @@ from pathlib import Path
 import pytest
 
 from ikteach.course import grade
-from ikteach.course.grading.sandbox import Sandbox, SandboxUnavailable
+from sandboxes import SANDBOXED
 
 ROOT = Path(__file__).resolve().parents[1]
 WRONG = ROOT / "tests" / "submissions"
@@ -39,15 +39,6 @@ ODD_STUDENT = b"student-\xff-name"          # a folder name that is not UTF-8
 ODD_FILE = b"02_jt_step-\xfe.ipynb"          # a notebook name that is not UTF-8
 
 
-def _have_sandbox():
-    try:
-        Sandbox().close()
-        return True
-    except SandboxUnavailable:
-        return False
-
-
-SANDBOXED = _have_sandbox()
 STUDENTS = sorted(p.name for p in WRONG.iterdir() if p.is_dir()
                   and (SANDBOXED or p.name not in NEEDS_SANDBOX))
 Graded = collections.namedtuple("Graded", "rows feedback before log stderr refusal")

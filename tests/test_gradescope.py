@@ -11,20 +11,9 @@ from pathlib import Path
 import pytest
 
 from ikteach.course.grading import gradescope
-from ikteach.course.grading.sandbox import Sandbox, SandboxUnavailable
+from sandboxes import SANDBOXED
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def _have_sandbox():
-    try:
-        Sandbox().close()
-        return True
-    except SandboxUnavailable:
-        return False
-
-
-SANDBOXED = _have_sandbox()
 
 
 @pytest.fixture(scope="module")

@@ -14,20 +14,10 @@ import pytest
 
 from ikteach.course.grading import bwrap, extract
 from ikteach.course.grading.sandbox import Limits, Sandbox, SandboxUnavailable
+from sandboxes import SANDBOXED
 
 PACKAGE = Path(__file__).resolve().parents[1] / "ikteach"
 TMP = Path(tempfile.gettempdir()).resolve()
-
-
-def _have_sandbox():
-    try:
-        Sandbox().close()
-        return True
-    except SandboxUnavailable:
-        return False
-
-
-SANDBOXED = _have_sandbox()
 
 
 def run_in(sandbox, tmp_path, code):
