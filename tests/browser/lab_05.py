@@ -5,117 +5,38 @@ not collected by `make test` (the file name does not start with test_). Selenium
 /usr/bin/chromium through /usr/bin/chromedriver: nothing is downloaded at run time.
 Screenshots (1280x720) go to $BROWSER_SHOTS (default /tmp/ikteach-browser).
 """
-import json
 import os
-import re
-import shutil
-import socket
-import subprocess
-import sys
 import time
-import urllib.request
 from pathlib import Path
 
 import pytest
 
-webdriver = pytest.importorskip("selenium.webdriver")
+pytest.importorskip("selenium.webdriver")
 from selenium.webdriver.common.action_chains import ActionChains  # noqa: E402
 from selenium.webdriver.common.by import By  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[2]
+from labdriver import (HEIGHT, ROOT, WIDTH, chromium, code_cell_count,  # noqa: E402
+                       jupyterlab, run_all, wait_until as _wait_until)
+
 NOTEBOOK = "05_singularities_out_of_reach.ipynb"
-CHROMIUM, CHROMEDRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
 SHOTS = Path(os.environ.get("BROWSER_SHOTS", "/tmp/ikteach-browser"))
-WIDTH, HEIGHT = 1280, 720
-TOKEN = "ikteach-browser-test"
 RUN_ALL_TIMEOUT = 600  # s: the whole notebook on a busy 2-core machine
-FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync",
-         "--disable-dev-shm-usage", "--hide-scrollbars", "--force-device-scale-factor=1")
-# No news toast over the notebook; a fresh settings folder otherwise.
-# Every cell kept in the page (no windowing), so all prompts and outputs can be found.
-SETTINGS = {"@jupyterlab/apputils-extension/notification.jupyterlab-settings":
-            '{"fetchNews": "false", "checkForUpdates": false}',
-            "@jupyterlab/notebook-extension/tracker.jupyterlab-settings":
-            '{"windowingMode": "none"}'}
-
-
-def _free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def _wait_until(condition, timeout, what, every=0.25):
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        value = condition()
-        if value:
-            return value
-        time.sleep(every)
-    raise AssertionError(f"timed out after {timeout} s waiting for {what}")
 
 
 @pytest.fixture(scope="module")
 def lab(tmp_path_factory):
     """JupyterLab on a free port with a token, serving a copy of notebook 05 (never the repo's)."""
-    home = tmp_path_factory.mktemp("lab")
-    shutil.copy(ROOT / "notebooks" / NOTEBOOK, home / NOTEBOOK)
-    settings = home / ".settings"
-    for name, text in SETTINGS.items():
-        (settings / name).parent.mkdir(parents=True, exist_ok=True)
-        (settings / name).write_text(text)
-    port = _free_port()
-    env = dict(os.environ, PYVISTA_OFF_SCREEN="true", JUPYTER_CONFIG_DIR=str(home / ".config"),
-               JUPYTER_RUNTIME_DIR=str(home / ".runtime"))
-    log = open(home / "lab.log", "w")
-    server = subprocess.Popen(
-        [sys.executable, "-m", "jupyter", "lab", "--no-browser", f"--port={port}",
-         "--ip=127.0.0.1", f"--IdentityProvider.token={TOKEN}", f"--ServerApp.root_dir={home}",
-         f"--LabApp.user_settings_dir={settings}", f"--LabApp.workspaces_dir={home / '.ws'}",
-         "--ServerApp.allow_root=True"],
-        cwd=home, env=env, stdout=log, stderr=subprocess.STDOUT)
-    url = f"http://127.0.0.1:{port}"
-
-    def up():
-        try:
-            return urllib.request.urlopen(f"{url}/api/status?token={TOKEN}", timeout=2).status == 200
-        except OSError:
-            return server.poll() is not None  # died: stop waiting, fail below
-
-    _wait_until(up, 120, "JupyterLab to start")
-    assert server.poll() is None, (home / "lab.log").read_text()[-3000:]
-    yield url
-    server.terminate()
-    server.wait(timeout=30)
-    log.close()
+    with jupyterlab(tmp_path_factory.mktemp("lab"), [ROOT / "notebooks" / NOTEBOOK]) as url:
+        yield url
 
 
 @pytest.fixture(scope="module")
 def browser():
-    from selenium.webdriver.chrome.service import Service
-
-    options = webdriver.ChromeOptions()
-    options.binary_location = CHROMIUM
-    for flag in FLAGS:
-        options.add_argument(flag)
-    profile = Path(os.environ.get("TMPDIR", "/tmp")) / f"ikteach-chromium-{os.getpid()}"
-    options.add_argument(f"--user-data-dir={profile}")
-    options.add_argument(f"--window-size={WIDTH},{HEIGHT}")
-    driver = webdriver.Chrome(service=Service(executable_path=CHROMEDRIVER), options=options)
-    driver.set_window_size(WIDTH, HEIGHT)
     SHOTS.mkdir(parents=True, exist_ok=True)
     for stale in (*SHOTS.glob("failed-*"), *SHOTS.glob("demo*.png"), *SHOTS.glob("animation*.png")):
         stale.unlink()
-    yield driver
-    driver.quit()
-    shutil.rmtree(profile, ignore_errors=True)
-
-
-def _kernel_states(lab):
-    """Execution state of each running session's kernel, from the server's REST API."""
-    with urllib.request.urlopen(f"{lab}/api/sessions?token={TOKEN}", timeout=5) as reply:
-        return [s["kernel"]["execution_state"] for s in json.load(reply)]
+    with chromium() as driver:
+        yield driver
 
 
 def _shot(driver, name):
@@ -137,22 +58,7 @@ def notebook(lab, browser):
 
 
 def _run_all(lab, browser):
-    browser.get(f"{lab}/lab/tree/{NOTEBOOK}?token={TOKEN}")
-    _wait_until(lambda: browser.find_elements(By.CSS_SELECTOR, ".jp-Notebook .jp-Cell"), 120,
-                "the notebook to open")
-    _wait_until(lambda: _kernel_states(lab) == ["idle"], 180, "the kernel to start")
-    browser.find_element(By.XPATH, "//li[contains(@class,'lm-MenuBar-item')][.='Run']").click()
-    browser.find_element(By.XPATH, "//li[contains(@class,'lm-Menu-item')]"
-                                   "[.//*[normalize-space()='Run All Cells']]").click()
-    cells = json.loads((ROOT / "notebooks" / NOTEBOOK).read_text())["cells"]
-    count = sum(cell["cell_type"] == "code" for cell in cells)
-
-    def finished():  # every code cell numbered ([12]:), none pending ([*]:) or queued ([ ]:)
-        prompts = _js(browser, "return [...document.querySelectorAll('.jp-CodeCell .jp-InputPrompt')]"
-                               ".map(p => p.innerText.trim())")
-        return len(prompts) == count and all(re.fullmatch(r"\[\d+\]:?", p) for p in prompts)
-
-    _wait_until(finished, RUN_ALL_TIMEOUT, "Run All to finish", every=1.0)
+    run_all(browser, lab, NOTEBOOK, code_cell_count(ROOT / "notebooks" / NOTEBOOK), RUN_ALL_TIMEOUT)
     errors = browser.find_elements(By.CSS_SELECTOR, "[data-mime-type='application/vnd.jupyter.stderr']")
     tracebacks = [e.text for e in errors if "Traceback" in e.text or "Error" in e.text]
     assert not tracebacks, tracebacks[0][:2000]
