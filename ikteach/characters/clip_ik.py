@@ -11,10 +11,13 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..core._validate import as_array, as_count, as_number
-from ..core.solve import METHODS, STATUSES, Settings, run_loop
+from ..core._validate import as_array
+from ..core.dls import DLS
+from ..core.loop import STATUSES, iterate, start
+from ..core.options import Options
+from ..core.problem import Problem
 from ..core.tree import TreeTask, tree_jacobian, tree_size
-from .._runtime import jit as runtime_jit
+from .._runtime import engine, jit as runtime_jit
 
 
 @dataclasses.dataclass(frozen=True)
@@ -34,12 +37,11 @@ jax.tree_util.register_dataclass(MaskedTreeTask, data_fields=[], meta_fields=["m
 
 
 @runtime_jit.jit
-def _solve_clip(task, arm, targets, theta, settings, max_iter):
-    method = METHODS["dls"]
-
+def _solve_clip(task, arm, targets, theta, method, options):
     def frame(correction, inputs):
         target, clip = inputs
-        state = run_loop(method, task, arm, target, clip + correction, settings, max_iter, False)
+        state = engine.until_stopped(iterate, (Problem(task, arm, target), method, options),
+                                     start(clip + correction))
         return state.theta - clip, (state.theta, state.error, state.i, state.status)
 
     _, out = jax.lax.scan(frame, jnp.zeros_like(theta[0]), (targets, theta))
@@ -74,13 +76,12 @@ def solve_clip(rig, root, theta, targets, active, tol=1e-3, max_iter=50, damping
         raise ValueError(f"active: expected indices of revolute joints in [0, {rig.n_joints}), "
                          f"got {active!r:.80}")
     mask[index] = 1.0
-    settings = Settings(tol=as_number(tol, "tol", minimum=0, strict=True),
-                        damping=as_number(damping, "damping", minimum=0), rcond=0.0,
-                        clamp=np.inf if clamp is None else as_number(clamp, "clamp", minimum=0, strict=True),
-                        max_step=np.inf, stall_tol=1e-7 * tree_size(rig.tree))
+    size = tree_size(rig.tree)
+    options = Options(tol=tol, clamp=clamp, max_iter=max_iter, stall_tol=1e-7 * size)
     task = MaskedTreeTask(mask=tuple(mask.tolist()))
     local = targets - root[:, None, :]          # the tree is built around the root
-    thetas, errors, iterations, status = _solve_clip(task, rig.tree, jnp.asarray(local), jnp.asarray(theta),
-                                                     settings, np.int64(as_count(max_iter, "max_iter")))
+    thetas, errors, iterations, status = _solve_clip(task, rig.tree, jnp.asarray(local),
+                                                     jnp.asarray(theta), DLS(damping),
+                                                     options.resolved(size, rig.n_joints))
     return ClipResult(np.asarray(thetas), np.asarray(errors), np.asarray(iterations),
                       np.asarray(STATUSES, dtype=object)[np.asarray(status)])

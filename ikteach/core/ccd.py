@@ -1,12 +1,11 @@
 """Cyclic coordinate descent: turn one joint at a time, last to first, to point the end
 effector at the target (Wang & Chen 1991; Welman 1993)."""
-import dataclasses
-
 import jax
 import jax.numpy as jnp
 
 from .chain import Chain
 from .kinematics import joint_frames
+from .method import method
 
 
 def ccd_angle(z, p, x, t):
@@ -45,10 +44,13 @@ def require_chain(arm, name):
                          f"with position targets, got {type(arm).__name__}")
 
 
-@dataclasses.dataclass(frozen=True)
-class CCDMethod:
+@method(data=())
+class CCD:
     """CCD as a solve method: delta_theta = (theta after one sweep) - theta."""
+    uses_jacobian = False
 
-    def delta(self, task, arm, target, theta, e, settings):
-        require_chain(arm, "ccd")
-        return ccd_sweep(arm, target, theta) - theta
+    def delta(self, problem, theta, e, J, free=None):
+        return ccd_sweep(problem.arm, problem.target, theta) - theta
+
+    def resolved(self, length_scale):
+        return self

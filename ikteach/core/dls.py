@@ -2,30 +2,10 @@
 import jax
 import jax.numpy as jnp
 
-from .small_solve import solve_small
+from ._validate import as_number
+from .method import JacobianMethod, method, replace
 
-WELL_POSED = 1e-10  # det(A) / prod(diag A) above this: the m x m solve is far above rounding
-FLOOR = 1e-6        # lambda^2 below FLOOR * trace(J J^T) / m on an ill-posed A: raised by that
-
-
-def well_posed(A):
-    """Is det(A) clearly above rounding? For A = J J^T + lambda^2 I (symmetric, positive
-    semidefinite) det(A) <= prod(diag A), with equality when the rows of J are orthogonal;
-    the ratio falls to rounding (about 1e-16) when A is singular to working precision."""
-    m = A.shape[0]
-    diag = jnp.diagonal(A)
-    det = solve_small_det(A) if m <= 3 else jnp.linalg.det(A)
-    return det > WELL_POSED * jnp.prod(diag)
-
-
-def solve_small_det(A):
-    """det(A) for m <= 3, the same products as solve_small's closed form."""
-    m = A.shape[0]
-    if m == 1:
-        return A[0, 0]
-    if m == 2:
-        return A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
-    return jnp.dot(A[0], jnp.cross(A[1], A[2]))
+DAMPING_PER_LENGTH = 6  # default lambda = L / 6 (0.5 for three unit links; L: the arm's size)
 
 
 @jax.jit
@@ -33,18 +13,12 @@ def dls_step(J, e, damping):
     """delta_theta = J^T (J J^T + lambda^2 I)^-1 e: an m x m solve (m = rows of J).
 
     Equal to dls_step_normal by (J^T J + lambda^2 I)^-1 J^T = J^T (J J^T + lambda^2 I)^-1,
-    and cheaper when n >> m. solve_small: closed form for m <= 3, LU above.
-    With lambda = 0 (or tiny) at a singular J the system is singular: then, and only then
-    (lambda^2 < FLOOR trace(J J^T) / m and det(A) lost in rounding), lambda^2 is raised by
-    FLOOR trace(J J^T) / m, so the step stays finite; every other step is the plain formula.
+    and cheaper when n >> m. With lambda = 0 at a singular J the system is singular and the
+    step is not finite (the solve loop then stops "diverged").
     """
     J, e = jnp.asarray(J), jnp.asarray(e)
     m = J.shape[0]
-    G = J @ J.T
-    A = G + damping**2 * jnp.eye(m)
-    floor = FLOOR * jnp.trace(G) / m
-    A = jnp.where((damping**2 < floor) & ~well_posed(A), A + floor * jnp.eye(m), A)
-    return J.T @ solve_small(A, e)
+    return J.T @ jnp.linalg.solve(J @ J.T + damping**2 * jnp.eye(m), e)
 
 
 @jax.jit
@@ -53,3 +27,21 @@ def dls_step_normal(J, e, damping):
     J, e = jnp.asarray(J), jnp.asarray(e)
     n = J.shape[1]
     return jnp.linalg.solve(J.T @ J + damping**2 * jnp.eye(n), J.T @ e)
+
+
+@method(data=("damping",))
+class DLS(JacobianMethod):
+    """Damped least squares with damping lambda (a length: default L / 6)."""
+    damping: float = None
+
+    def __post_init__(self):
+        if self.damping is not None:
+            object.__setattr__(self, "damping", as_number(self.damping, "damping", minimum=0))
+
+    def step(self, J, e):
+        return dls_step(J, e, self.damping)
+
+    def resolved(self, length_scale):
+        if self.damping is not None:
+            return self
+        return replace(self, damping=length_scale / DAMPING_PER_LENGTH)

@@ -9,13 +9,12 @@ base first, is turned (ccd_angle) to point its link at the new p_{i+1}. For a pl
 this reproduces the points exactly; for a spatial hinge chain it is the nearest the hinges
 allow, one joint at a time.
 """
-import dataclasses
-
 import jax
 import jax.numpy as jnp
 
-from .ccd import as_point3, ccd_angle, require_chain
+from .ccd import as_point3, ccd_angle
 from .kinematics import joint_frames
+from .method import method
 
 EPS = 1e-12
 
@@ -74,13 +73,17 @@ def angles_toward_points(arm, theta, points):
     return jax.lax.fori_loop(0, arm.n_joints, turn, jnp.asarray(theta))
 
 
-@dataclasses.dataclass(frozen=True)
-class FABRIKMethod:
+@method(data=())
+class FABRIK:
     """FABRIK as a solve method: one pass on the points, then back to angles."""
+    uses_jacobian = False
 
-    def delta(self, task, arm, target, theta, e, settings):
-        require_chain(arm, "fabrik")
+    def delta(self, problem, theta, e, J, free=None):
+        arm = problem.arm
         positions = joint_frames(arm, theta)[0]
         lengths = jnp.linalg.norm(jnp.asarray(arm.offsets), axis=1)
-        points = fabrik_pass(positions, lengths, as_point3(arm, target))
+        points = fabrik_pass(positions, lengths, as_point3(arm, problem.target))
         return angles_toward_points(arm, theta, points) - theta
+
+    def resolved(self, length_scale):
+        return self

@@ -11,19 +11,14 @@ Two ways to respect them (ik.solve(..., joint_limits=(lower, upper), limit_mode=
                  joints. Repeat until no free joint overshoots (at most n passes).
                  Needs a Jacobian method: jt, pinv, dls, sdls, a step function, priorities.
 
-The limits travel in the loop's Settings (traced), so new limits do not recompile.
+The limits travel in the loop's Options (traced), so new limits do not recompile.
 """
-import dataclasses
-
 import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ._validate import numeric
-from .limits import cap_step, clamp_error
-from .sdls import SDLSMethod, sdls_step
-
-LIMIT_MODES = ("clamp", "clamping_loop")
+from .method import method
+from .safeguards import cap_step
 
 
 def within(theta, lower, upper):
@@ -73,77 +68,37 @@ def while_loop(cond, body, carry):
     return carry
 
 
-def jacobian_step(method, task, theta, settings):
-    """The method's step as a function (J, e, free) -> delta, or None when it does not use J."""
-    if hasattr(method, "jacobian_step"):  # priorities
-        return method.jacobian_step(task, theta, settings)
-    if isinstance(method, SDLSMethod):
-        block = getattr(task, "block_size", None)
-        return lambda J, e, free: sdls_step(J, e, settings.gamma_max, block or J.shape[0])
-    if hasattr(method, "step"):  # jt, pinv, dls, a user's step function
-        return lambda J, e, free: method.step(J, e, settings)
-    return None
-
-
-@dataclasses.dataclass(frozen=True)
-class LimitedMethod:
-    """A solve method whose steps keep every joint within settings.lower..settings.upper."""
+@method(data=("inner", "lower", "upper", "max_step"))
+class ClampingLoop:
+    """A Jacobian method whose steps re-solve with the joints that hit a limit pinned."""
     inner: object
-    mode: str
+    lower: object
+    upper: object
+    max_step: float
+    uses_jacobian = True
 
-    def delta(self, task, arm, target, theta, e, settings):
-        if self.mode == "clamp":
-            delta = cap_step(self.inner.delta(task, arm, target, theta, e, settings), settings.max_step)
-            return within(theta + delta, settings.lower, settings.upper) - theta
-        J = task.jacobian(arm, theta)
-        solve_free = jacobian_step(self.inner, task, theta, settings)
-        return clamping_loop(solve_free, J, clamp_error(e, settings.clamp), theta,
-                             settings.lower, settings.upper, settings.max_step)
+    def delta(self, problem, theta, e, J, free=None):
+        def solve_free(J_free, e_rest, free):
+            return self.inner.delta(problem, theta, e_rest, J_free, free)
+        return clamping_loop(solve_free, J, e, theta, self.lower, self.upper, self.max_step)
 
-
-def check_limits(joint_limits, n):
-    """(lower, upper) as two float arrays of shape (n,); a number applies to every joint."""
-    try:
-        lower, upper = joint_limits
-    except (TypeError, ValueError):
-        raise ValueError(f"joint_limits: expected a pair (lower, upper) of per-joint arrays, "
-                         f"got {joint_limits!r:.80}") from None
-    out = []
-    for name, bound, bad in (("lower", lower, np.inf), ("upper", upper, -np.inf)):
-        try:
-            arr = np.broadcast_to(numeric(bound, "joint_limits"), (n,)).copy()
-        except ValueError:
-            raise ValueError(f"joint_limits: expected {name} as a number or shape ({n},) "
-                             f"(one per joint), got {bound!r:.80}") from None
-        if np.any(np.isnan(arr)) or np.any(arr == bad):
-            raise ValueError(f"joint_limits: {name} must be numbers (or {-bad} for no limit), "
-                             f"got {arr.tolist()}")
-        out.append(arr)
-    if np.any(out[0] > out[1]):
-        j = int(np.argmax(out[0] > out[1]))
-        raise ValueError(f"joint_limits: expected lower <= upper, got lower[{j}] = {out[0][j]} "
-                         f"> upper[{j}] = {out[1][j]}")
-    return out[0], out[1]
+    def resolved(self, length_scale):
+        return self
 
 
-def with_limits(method, settings, theta0, joint_limits, limit_mode, n):
-    """The solve's method, settings and start with joint limits on (unchanged without them).
-
-    A start outside the limits is first moved onto them, so no result can break them.
-    """
-    if limit_mode not in (None,) + LIMIT_MODES:
-        raise ValueError(f"limit_mode: expected one of {LIMIT_MODES}, got {limit_mode!r:.80}")
-    if joint_limits is None:
-        if limit_mode is not None:
-            raise ValueError(f"limit_mode: {limit_mode!r} says how to keep joint limits, so it "
-                             f"needs joint_limits=(lower, upper)")
-        return method, settings, theta0
-    lower, upper = check_limits(joint_limits, n)
-    has_jacobian = jacobian_step(method, None, None, settings) is not None
-    if limit_mode is None:
-        limit_mode = "clamping_loop" if has_jacobian else "clamp"
-    if limit_mode == "clamping_loop" and not has_jacobian:
+def with_limits(method, options):
+    """The solve's method with joint limits (options resolved): the clamping loop for a
+    Jacobian method unless limit_mode="clamp"; with "clamp" (or CCD, FABRIK) the loop's own
+    clip into the limits after each step is all there is. A start outside the limits is moved
+    onto them by the caller (within)."""
+    if options.joint_limits is None or not np.any(np.isfinite(np.concatenate(options.joint_limits))):
+        return method
+    mode = options.limit_mode
+    if mode is None:
+        mode = "clamping_loop" if method.uses_jacobian else "clamp"
+    if mode == "clamp":
+        return method
+    if not method.uses_jacobian:
         raise ValueError("limit_mode: 'clamping_loop' re-solves with J, so it needs a Jacobian "
                          "method (jt, pinv, dls, sdls or a step function); use 'clamp' here")
-    settings = settings._replace(lower=jnp.asarray(lower), upper=jnp.asarray(upper))
-    return LimitedMethod(method, limit_mode), settings, within(jnp.asarray(theta0), lower, upper)
+    return ClampingLoop(method, *options.joint_limits, options.max_step)

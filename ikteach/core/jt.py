@@ -2,6 +2,8 @@
 import jax
 import jax.numpy as jnp
 
+from .method import JacobianMethod, method
+
 
 @jax.jit
 def optimal_alpha(J, e):
@@ -11,10 +13,8 @@ def optimal_alpha(J, e):
     is equally good; 0 is returned so the step is 0, never NaN.
     """
     v = J @ (J.T @ e)
-    ev, vv = jnp.stack([e, v]) @ v  # <e, v>, <v, v>: one matrix-vector product, summed in
-    # the same order in ik.solve and in ik.solve_batch's vectorised queue (jnp.dot is not)
-    safe = jnp.where(vv > 0, vv, 1.0)
-    return jnp.where(vv > 0, ev / safe, 0.0)
+    vv = jnp.dot(v, v)
+    return jnp.where(vv > 0, jnp.dot(e, v) / jnp.where(vv > 0, vv, 1.0), 0.0)
 
 
 @jax.jit
@@ -22,3 +22,11 @@ def jt_step(J, e):
     """Jacobian-transpose step: delta_theta = alpha J^T e, alpha from optimal_alpha."""
     J, e = jnp.asarray(J), jnp.asarray(e)
     return optimal_alpha(J, e) * (J.T @ e)
+
+
+@method(data=())
+class JT(JacobianMethod):
+    """The Jacobian transpose with Buss's optimal alpha (no parameters)."""
+
+    def step(self, J, e):
+        return jt_step(J, e)

@@ -10,14 +10,11 @@ with J = I: with the freedom that is still left, drift back towards a preferred 
 The loop itself is unchanged: it stops "converged" when the whole error (every level,
 not the rest pose) is below tol, and "stalled" when the levels conflict and the step dies out.
 """
-import dataclasses
-
 import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ._validate import as_array, as_number
-from .limits import clamp_error
+from .method import JacobianMethod, method
 from .pose import PoseTask
 from .priority import multilevel_step
 
@@ -31,48 +28,40 @@ def block_size(task, rows):
     return getattr(task, "block_size", None) or rows
 
 
-@dataclasses.dataclass(frozen=True)
-class PriorityMethod:
-    """The damped multilevel priority step as a solve method (levels: one per error block)."""
+@method(data=("damping", "rest_pose", "rest_gain"), meta=("levels", "block"))
+class Priorities(JacobianMethod):
+    """The damped multilevel priority step (levels: one per error block of `block` rows)."""
     levels: tuple
-    rest: bool
+    block: int
+    damping: float
+    rest_pose: object = None
+    rest_gain: float = 0.0
 
-    def rows_by_level(self, rows, block):
-        per_row = np.repeat(np.asarray(self.levels), block)
+    def rows_by_level(self, rows):
+        per_row = np.repeat(np.asarray(self.levels), self.block)
         return [np.flatnonzero(per_row == level) for level in sorted(set(self.levels))]
 
-    def jacobian_step(self, task, theta, settings):
-        """(J, e) -> delta: J's rows split by level, the rest pose (if any) as the last level."""
-        def step(J, e, free):
-            groups = self.rows_by_level(J.shape[0], block_size(task, J.shape[0]))
-            parts = [(J[rows], e[rows]) for rows in groups]
-            if self.rest:  # J = I, less the joints the caller pinned (free = False)
-                rest_error = settings.rest_gain * (settings.rest_pose - theta)
-                parts.append((jnp.diag(free.astype(J.dtype)), rest_error))
-            return multilevel_step(parts, settings.damping)
-        return step
-
-    def delta(self, task, arm, target, theta, e, settings):
-        J = task.jacobian(arm, theta)
-        free = jnp.ones(theta.shape[0], bool)
-        return self.jacobian_step(task, theta, settings)(J, clamp_error(e, settings.clamp), free)
+    def delta(self, problem, theta, e, J, free=None):
+        """J's rows split by level, the rest pose (if any) as the last level, J = I there
+        less the joints a joint-limit pass pinned (free = False)."""
+        parts = [(J[rows], e[rows]) for rows in self.rows_by_level(J.shape[0])]
+        if self.rest_pose is not None:
+            free = jnp.ones(theta.shape[0], bool) if free is None else free
+            parts.append((jnp.diag(free.astype(J.dtype)), self.rest_gain * (self.rest_pose - theta)))
+        return multilevel_step(parts, self.damping)
 
 
-def with_priorities(method, task, arm, target, theta0, settings, levels, rest_pose, rest_gain,
-                    is_default):
-    """The solve's method and settings with priority levels / a rest pose (unchanged without)."""
-    if rest_pose is None and rest_gain is not None:
-        raise ValueError("rest_gain: the gain of the rest-pose level, so it needs rest_pose= "
-                         "(the pose to drift back to)")
-    if levels is None and rest_pose is None:
-        return method, settings
-    if not is_default:
+def with_priorities(method, problem, theta0, options):
+    """The solve's method with priority levels / a rest pose (unchanged without them)."""
+    if options.levels is None and options.rest_pose is None:
+        return method
+    if getattr(method, "damping", None) is None:
         raise ValueError("method: levels= and rest_pose= use the damped priority step "
-                         "(ik.multilevel_step with damping=); leave method='dls'")
-    rows = jax.eval_shape(lambda q: task.error(arm, target, q), theta0).shape[0]
-    blocks = rows // block_size(task, rows)
-    if levels is None:
-        levels = (0,) * blocks
+                         "(ik.multilevel_step with damping=); use method='dls' or ik.DLS(damping)")
+    rows = jax.eval_shape(problem.error, theta0).shape[0]
+    block = block_size(problem.task, rows)
+    blocks = rows // block
+    levels = (0,) * blocks if options.levels is None else options.levels
     if isinstance(levels, (str, bytes)) or not np.iterable(levels) or any(
             isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) for v in levels):
         raise ValueError(f"levels: expected one integer priority per target block "
@@ -81,9 +70,11 @@ def with_priorities(method, task, arm, target, theta0, settings, levels, rest_po
     if len(levels) != blocks or min(levels) < 0:
         raise ValueError(f"levels: expected {blocks} priorities >= 0 (one per "
                          f"{'end effector' if blocks > 1 else 'target'}), got {list(levels)}")
+    rest_pose, gain = options.rest_pose, 0.0
     if rest_pose is not None:
-        rest_pose = as_array(rest_pose, "rest_pose", shape=(arm.n_joints,))
-        gain = as_number(DEFAULT_REST_GAIN if rest_gain is None else rest_gain, "rest_gain",
-                         minimum=0, strict=True)
-        settings = settings._replace(rest_pose=jnp.asarray(rest_pose), rest_gain=gain)
-    return PriorityMethod(levels, rest_pose is not None), settings
+        if np.shape(rest_pose) != np.shape(theta0):
+            raise ValueError(f"rest_pose: expected shape {np.shape(theta0)} (one angle per "
+                             f"joint), got shape {np.shape(rest_pose)}")
+        rest_pose = jnp.asarray(rest_pose)
+        gain = DEFAULT_REST_GAIN if options.rest_gain is None else options.rest_gain
+    return Priorities(levels, block, method.damping, rest_pose, gain)

@@ -20,7 +20,6 @@ from ._validate import as_number
 from .chain import Chain, reach
 from .jacobian import jacobian
 from .kinematics import joint_frames, skew
-from .tasks import TASKS
 
 # Below sin^2(angle) = SMALL the log uses its Taylor series; above cos(angle) = NEAR_PI
 # the axis is read from the symmetric part of R. Both branches are exact to float64.
@@ -190,7 +189,3 @@ def make_pose(R, p):
     top = jnp.hstack([jnp.asarray(R, dtype=float), jnp.asarray(p, dtype=float)[:, None]])
     return jnp.vstack([top, jnp.array([[0.0, 0.0, 0.0, 1.0]])])
 
-
-# Registration: ik.solve / ik.solve_batch accept a 4x4 target for a spatial chain.
-if not any(isinstance(t, PoseTask) for t in TASKS):
-    TASKS.append(PoseTask())

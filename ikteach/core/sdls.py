@@ -19,14 +19,15 @@ is what soft=True does: each direction's term w is added as w gamma_i / (gamma_i
 (always, not only when max|w| > gamma_i), and a sum with max|.| = c > gamma_max is scaled by
 gamma_max / (gamma_max + c) (so its largest turn is below gamma_max, not equal to it).
 """
-import dataclasses
 import functools
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .limits import cap_step, clamp_error
+from ._validate import as_number
+from .method import JacobianMethod, method
+from .safeguards import cap_step
 
 GAMMA_MAX = np.pi / 4   # Buss & Kim 2005, section 4
 NEAR_ZERO = 1e-10       # singular values below this are skipped (as in Buss's demo code)
@@ -74,11 +75,17 @@ def sdls_step(J, e, gamma_max=GAMMA_MAX, block=None, soft=False):
     return cap_step(phi.sum(axis=0), gamma_max)
 
 
-@dataclasses.dataclass(frozen=True)
-class SDLSMethod:
-    """SDLS as a solve method: e is clamped to D_max (clamp=) first, blocks per end effector."""
+@method(data=("gamma_max",))
+class SDLS(JacobianMethod):
+    """SDLS with largest joint turn gamma_max per step; J's blocks are the end effectors."""
+    gamma_max: float = GAMMA_MAX
 
-    def delta(self, task, arm, target, theta, e, settings):
-        J = task.jacobian(arm, theta)
-        block = getattr(task, "block_size", J.shape[0])
-        return sdls_step(J, clamp_error(e, settings.clamp), settings.gamma_max, block)
+    def __post_init__(self):
+        object.__setattr__(self, "gamma_max",
+                           as_number(self.gamma_max, "gamma_max", minimum=0, strict=True))
+
+    def delta(self, problem, theta, e, J, free=None):
+        return sdls_step(J, e, self.gamma_max, problem.rows_per_effector(J.shape[0]))
+
+    def step(self, J, e):
+        return sdls_step(J, e, self.gamma_max)

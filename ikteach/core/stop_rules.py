@@ -37,8 +37,6 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .joint_limits import LimitedMethod
-from .levels import PriorityMethod
 from .._runtime import jit as runtime_jit
 
 STOP_RULES = ("joint_steps", "motion")
@@ -49,11 +47,11 @@ CURVATURE_FRACTION = 1e-6  # a saddle: an eigenvalue of H below -this fraction o
 MINIMUM, SADDLE, CUT_SHORT = range(3)  # what stall_kind returns
 
 
-def rule_index(rule):
-    """The rule's number (what the traced loop reads), or a ValueError naming stop_rule."""
-    if rule not in STOP_RULES:
+def check_rule(rule):
+    """The rule's name, or a ValueError naming stop_rule."""
+    if not isinstance(rule, str) or rule not in STOP_RULES:
         raise ValueError(f"stop_rule: expected one of {list(STOP_RULES)}, got {rule!r:.80}")
-    return STOP_RULES.index(rule)
+    return rule
 
 
 def joint_steps(delta_theta):
@@ -66,17 +64,9 @@ def motion(J, delta_theta):
     return jnp.linalg.norm(J @ delta_theta)
 
 
-def step_size(rule, jacobian_at_theta, delta_theta):
-    """The size the stall rule compares with stall_tol (rule: a traced index into STOP_RULES).
-
-    jacobian_at_theta() is only evaluated for the "motion" rule. Outside a trace (an eager
-    solve with a numpy step function) the rule is a plain number: a Python branch, since an
-    eager lax.cond on a fresh lambda compiles anew on every call.
-    """
-    if not isinstance(rule, jax.core.Tracer):
-        return motion(jacobian_at_theta(), delta_theta) if int(rule) == 1 else joint_steps(delta_theta)
-    return jax.lax.cond(rule == 1, lambda: motion(jacobian_at_theta(), delta_theta),
-                        lambda: joint_steps(delta_theta))
+def step_size(rule, J, delta_theta):
+    """The size the stall rule compares with stall_tol: rule "motion" or "joint_steps"."""
+    return motion(J, delta_theta) if rule == "motion" else joint_steps(delta_theta)
 
 
 def relative_progress(previous_error, error):
@@ -113,7 +103,7 @@ def _stall_kinds(task, arm, targets, thetas, lower, upper):
     return jax.vmap(lambda t, q: stall_kind(task, arm, t, q, lower, upper))(targets, thetas)
 
 
-def why_stalled(method, task, arm, targets, thetas, stalled, settings):
+def why_stalled(task, arm, targets, thetas, stalled, lower, upper, prioritised=False):
     """stall_kind of every row where `stalled` (MINIMUM elsewhere). Rows go in blocks of
     STALL_BLOCKS[0] (a few rows: a solve) or STALL_BLOCKS[1] (a batch), the last one padded:
     two compiled programs per problem, whatever the count (a new count would otherwise compile
@@ -121,13 +111,12 @@ def why_stalled(method, task, arm, targets, thetas, stalled, settings):
     at a compromise between levels, not at a minimum of ||e||: they are left as they are."""
     kinds = np.full(np.shape(stalled), MINIMUM)
     rows = np.flatnonzero(stalled)
-    inner = method.inner if isinstance(method, LimitedMethod) else method
-    if rows.size == 0 or isinstance(inner, PriorityMethod):
+    if rows.size == 0 or prioritised:
         return kinds
     block = STALL_BLOCKS[0] if rows.size <= STALL_BLOCKS[0] else STALL_BLOCKS[1]
     padded = np.concatenate([rows, np.repeat(rows[-1:], -rows.size % block)])
     n = np.shape(thetas)[-1]
-    bounds = [np.broadcast_to(np.asarray(b, dtype=float), (n,)) for b in (settings.lower, settings.upper)]
+    bounds = [np.broadcast_to(np.asarray(b, dtype=float), (n,)) for b in (lower, upper)]
     targets, thetas = np.asarray(targets), np.asarray(thetas)
     found = [_stall_kinds(task, arm, targets[part], thetas[part], *bounds)
              for part in padded.reshape(-1, block)]

@@ -1,8 +1,8 @@
 """What a solve aims at: a task gives the error vector e(theta) and its Jacobian.
 
 The solve loop is the same for every task; a task only says how far the arm is from
-the target and how that distance changes with theta. Position targets on chains are
-built in; other tasks (pose targets, trees) add themselves to TASKS.
+the target and how that distance changes with theta. TASKS lists them once: points for
+chains, 4x4 poses for spatial chains (pose.py), one point per end effector for trees (tree.py).
 """
 import dataclasses
 
@@ -11,6 +11,7 @@ import jax
 from .chain import Chain, reach
 from .jacobian import jacobian, jacobian_from_frames
 from .kinematics import fk, joint_frames
+from .pose import PoseTask
 from .tree import TreeTask
 
 
@@ -47,8 +48,7 @@ class PositionTask:
 jax.tree_util.register_dataclass(PositionTask, data_fields=[], meta_fields=[])
 jax.tree_util.register_dataclass(TreeTask, data_fields=[], meta_fields=[])
 
-TASKS = [PositionTask()]
-TASKS.append(TreeTask())  # trees: one target per end effector (ikteach/tree.py)
+TASKS = (PositionTask(), PoseTask(), TreeTask())
 
 
 def task_for(arm, target_shape, name="target"):

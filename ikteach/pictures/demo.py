@@ -33,6 +33,7 @@ from matplotlib.figure import Figure
 from . import plot
 from .stills import named_slider, png, still_html, with_still  # noqa: F401  (ik.demo.png)
 from ..core.chain import planar_chain, reach
+from ..core.methods import named
 from ..core.solve import solve
 
 PRESETS = {
@@ -254,8 +255,8 @@ class Demo:
         finally:
             self._holding = False
         target = np.array([self.x.value, self.y.value])
-        self.result = solve(self.arm, target, self.theta0, method=self.method.value,
-                            damping=self.damping.value, tol=self.tol, max_iter=self.max_iter,
+        self.result = solve(self.arm, target, self.theta0,
+                            method=named(self.method.value, damping=self.damping.value), tol=self.tol, max_iter=self.max_iter,
                             clamp=self.clamp)
         self.summary = summary(self.method.value, self.result)
         self.alt = alt_text(self.arm, target, self.summary)  # the still's <img alt>

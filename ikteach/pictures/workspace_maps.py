@@ -1,10 +1,10 @@
-"""Workspace maps of a planar arm (ik.workspace): the sweep and tracking of
-ikteach/core/workspace.py, drawn; the reachable set's boundary extracted with
+"""Workspace maps of a planar arm (ik.pictures.workspace_maps): the sweep and tracking of
+ikteach/core/sweeps.py, drawn; the reachable set's boundary extracted with
 skimage.measure.find_contours; a closed path taken from a scikit-image sample image.
 """
 import numpy as np
 
-from ..core.workspace import (Grid, SweepMap, Tracking, end_path, reach_radii, sigma_min,  # noqa: F401
+from ..core.sweeps import (Grid, SweepMap, Tracking, end_path, reach_radii, sigma_min,  # noqa: F401
                               sweep, target_grid, track)
 
 STATUS_COLORS = {"converged": "#55a868", "stalled": "#dd8452", "max_iter": "#c44e52",

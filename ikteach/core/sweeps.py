@@ -1,7 +1,7 @@
 """Workspace sweeps of a planar arm: solve a grid of targets at once (ik.solve_batch) and
 keep, per method, the iterations to converge, the final status and sigma_min; track a closed
 path with one update per frame (Buss's moving target). Drawing the maps, their boundaries and
-the image-derived paths: ikteach/pictures/workspace_maps.py (ik.workspace)."""
+the image-derived paths: ikteach/pictures/workspace_maps.py."""
 import dataclasses
 
 import jax
@@ -13,6 +13,7 @@ from .jacobian import jacobian
 from ._validate import as_array
 from .kinematics import end_path  # noqa: F401  (ws.end_path, used by the notebook)
 from .jitter import jitter_per_step
+from .methods import named
 from .solve import status_counts
 from .track import track as follow
 
@@ -68,7 +69,10 @@ class SweepMap:
 
 
 def _method_name(method):
-    return method if isinstance(method, str) else getattr(method, "__name__", "custom")
+    """A label: the method's name, its class's (DLS), or a step function's."""
+    if isinstance(method, str):
+        return method
+    return getattr(method, "__name__", type(method).__name__.lower())
 
 
 def sweep(arm, grid, theta0, method="dls", **kwargs):
@@ -119,6 +123,6 @@ def track(arm, path, theta0, method="dls", damping=0.5, rcond=1e-6, clamp=None, 
     """Buss's moving-target protocol along a path (k, d): one step of `method` per frame,
     from the previous theta (ik.track), kept with per-frame jitter for the maps notebook."""
     theta0 = as_array(theta0, "theta0", shape=(arm.n_joints,))
-    res = follow(arm, path, theta0, method=method, damping=damping, rcond=rcond, clamp=clamp,
-                 max_step=max_step)
+    res = follow(arm, path, theta0, method=named(method, damping=damping, rcond=rcond),
+                 clamp=clamp, max_step=max_step)
     return Tracking(_method_name(method), res.theta[1:], res.error)

@@ -1,0 +1,214 @@
+"""The engine: runs the course's loop function compiled, vectorised or eagerly, never rewrites it.
+
+Every function here takes `step`, a module-level function of the core (loop.iterate or a thin
+adaptor of it), and its arguments `args` (a pytree: the problem, method and options). A state
+is a NamedTuple with fields i, theta, error and status; it is running while status == RUNNING.
+
+  run_traced   ik.solve: a jax.lax.while_loop over step, TRACE_CHUNK passes per compiled run,
+               recording theta and ||e|| of every pass (memory follows the work, any max_iter
+               reuses the program);
+  run_eager    the same, one Python pass at a time, for step functions JAX cannot trace;
+  run_queue    ik.solve_batch: jax.vmap of step over `slots` targets in flight; a slot whose
+               target has finished takes the next one (the work is the sum of the iterations,
+               not the batch size times the largest count); split over CPU devices when several;
+  run_scan     ik.track: jax.lax.scan of one step per time step, SCAN_CHUNK steps per program;
+  until_stopped  the loop as one traceable while_loop, for a caller's own compiled program.
+"""
+import functools
+from functools import partial
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from . import jit as runtime_jit
+
+RUNNING = 0  # the loop's status while it runs (ikteach/core/loop.py)
+TRACE_CHUNK = 256  # passes per compiled run when the trace is kept
+SLOTS = 1024  # targets in flight at once (per device)
+SPLIT_FROM = 512  # targets per device below which a batch stays on one device
+STEPS_PER_REFILL = 4  # passes between refills (a refill costs more than a pass)
+SCAN_CHUNK = 128  # time steps per compiled scan: paths of any length reuse one program
+
+
+def same_types(new, old):
+    """new with the dtypes of old (a Python number in a step would otherwise change the
+    program's types from one pass to the next)."""
+    return jax.tree_util.tree_map(lambda n, o: jnp.asarray(n, dtype=jnp.asarray(o).dtype), new, old)
+
+
+def host_state(state):
+    """A state as numpy values of fixed dtypes (no small device programs to build it)."""
+    return jax.tree_util.tree_map(lambda x: np.asarray(x, dtype=np.result_type(x)), state)
+
+
+def until_stopped(step, args, state):
+    """step until the state stops, as one traceable jax.lax.while_loop (no trace kept): for
+    callers that compile a larger program around the loop (a whole clip, frame by frame)."""
+    return jax.lax.while_loop(lambda s: s.status == RUNNING,
+                              lambda s: same_types(step(*args, s), s), state)
+
+
+@partial(runtime_jit.jit, static_argnames=("step",))
+def _traced_chunk(step, args, state):
+    first = state.i
+    thetas = jnp.zeros((TRACE_CHUNK + 1,) + state.theta.shape).at[0].set(state.theta)
+    errors = jnp.zeros(TRACE_CHUNK + 1)
+
+    def body(carry):
+        state, thetas, errors = carry
+        new = same_types(step(*args, state), state)
+        row = state.i - first
+        return new, thetas.at[row + 1].set(new.theta), errors.at[row].set(new.error)
+
+    def more(carry):
+        return (carry[0].status == RUNNING) & (carry[0].i < first + TRACE_CHUNK)
+
+    return jax.lax.while_loop(more, body, (state, thetas, errors))
+
+
+def run_traced(step, args, state):
+    """Run step until the state stops, chunk by chunk; returns the last state (numpy) and the
+    trace: theta (k + 1, n) and error (k + 1,) for the k steps taken."""
+    state, thetas, errors = host_state(state), [], []
+    while True:
+        first = int(state.i)
+        state, chunk_thetas, chunk_errors = jax.device_get(_traced_chunk(step, args, state))
+        done = int(state.status) != RUNNING
+        k = int(state.i) - first
+        thetas.append(chunk_thetas[: k + done])
+        errors.append(chunk_errors[: k + done])
+        if done:
+            return state, np.concatenate(thetas), np.concatenate(errors)
+
+
+def run_eager(step, args, state, stop_exception, on_stop):
+    """run_traced's result, one Python pass at a time. When the step raises stop_exception
+    (a user's own stop rule), on_stop(state) -> state gives the stopped state."""
+    thetas, errors = [np.asarray(state.theta)], []
+    while int(state.status) == RUNNING:
+        try:
+            state = step(*args, state)
+        except stop_exception:
+            state = on_stop(state)
+        errors.append(float(state.error))
+        if int(state.status) == RUNNING:
+            thetas.append(np.asarray(state.theta))
+    return host_state(state), np.stack(thetas), np.asarray(errors)
+
+
+def _select(mask, a, b):
+    """Per slot: a where mask, else b (for every field of a state)."""
+    return jax.tree_util.tree_map(
+        lambda x, y: jnp.where(mask.reshape(mask.shape + (1,) * (x.ndim - 1)), x, y), a, b)
+
+
+def _queue(step, start, args, rows, starts, slots):
+    """Every row solved, `slots` at a time: step(args, row, state) -> state, start(theta0) -> state."""
+    count = starts.shape[0]
+    pick = lambda index: jax.tree_util.tree_map(lambda r: r[jnp.minimum(index, count - 1)], rows)
+    one_pass = jax.vmap(lambda row, s: same_types(step(args, row, s), s))
+    fresh = jax.vmap(start)
+
+    def load(index):  # fresh states for these rows; an index past the end marks an idle slot
+        state = fresh(starts[jnp.minimum(index, count - 1)])
+        return state._replace(status=jnp.where(index < count, state.status, -1))
+
+    def body(carry):
+        index, state, out, queued = carry
+        running = state.status == RUNNING
+        row = pick(index)
+        state = jax.lax.fori_loop(0, STEPS_PER_REFILL, lambda _, s: _select(
+            s.status == RUNNING, one_pass(row, s), s), state)
+        done = running & (state.status != RUNNING)
+        out = jax.tree_util.tree_map(
+            lambda o, x: o.at[jnp.where(done, index, count)].set(x, mode="drop"), out, state)
+        free = state.status != RUNNING
+        index = jnp.where(free, queued + jnp.cumsum(free) - 1, index)
+        state = _select(free, load(index), state)
+        return index, state, out, queued + jnp.sum(free)
+
+    index = jnp.arange(slots)
+    carry = (index, load(index), fresh(starts), jnp.asarray(slots))
+    return jax.lax.while_loop(lambda c: jnp.any(c[1].status == RUNNING), body, carry)[2]
+
+
+_run_queue = partial(runtime_jit.jit, static_argnames=("step", "start", "slots"))(_queue)
+
+
+def _shard_map():
+    """jax.shard_map and the keyword that turns its replication check off (older jax: the
+    experimental one); None when this jax has neither."""
+    if hasattr(jax, "shard_map"):
+        return jax.shard_map, {"check_vma": False}
+    try:
+        from jax.experimental.shard_map import shard_map
+    except ImportError:
+        return None
+    return shard_map, {"check_rep": False}
+
+
+@functools.lru_cache(maxsize=None)
+def _mesh(devices):
+    return jax.sharding.Mesh(np.array(devices), ("rows",))
+
+
+@partial(runtime_jit.jit, static_argnames=("step", "start", "slots", "mesh"))
+def _run_split(step, start, args, rows, starts, slots, mesh):
+    """_queue on every device of the mesh, each on its share of the rows."""
+    shard_map, check_off = _shard_map()
+    P = jax.sharding.PartitionSpec
+    share = lambda args, rows, starts: _queue(step, start, args, rows, starts, slots)
+    return shard_map(share, mesh=mesh, in_specs=(P(), P("rows"), P("rows")),
+                     out_specs=P("rows"), **check_off)(args, rows, starts)
+
+
+def split_devices(count):
+    """The devices a batch of `count` rows is split over: all local devices when there are
+    several and every share gets SPLIT_FROM rows or more; else None (one device)."""
+    devices = jax.local_devices()
+    if len(devices) < 2 or count < SPLIT_FROM * len(devices) or _shard_map() is None:
+        return None
+    return tuple(devices)
+
+
+def run_queue(step, start, args, rows, starts):
+    """Final states of every row (numpy). Over several devices, device k takes rows k, k + D,
+    k + 2D, ... (neighbouring rows cost alike, so the shares take about as long), the rows
+    padded to a multiple of D with copies of the last one, dropped again."""
+    count = starts.shape[0]
+    devices = split_devices(count)
+    if devices is None:
+        return jax.device_get(_run_queue(step, start, args, rows, starts, min(SLOTS, count)))
+    d = len(devices)
+    share = -(-count // d)
+    order = np.minimum(np.arange(share * d).reshape(share, d).T.ravel(), count - 1)
+    take = lambda x: np.asarray(x)[order]
+    state = _run_split(step, start, args, jax.tree_util.tree_map(take, rows), take(starts),
+                       min(SLOTS, share), _mesh(devices))
+    back = np.arange(count)
+    back = (back % d) * share + back // d  # where row r went
+    return jax.tree_util.tree_map(lambda x: np.asarray(x)[back], state)
+
+
+@partial(runtime_jit.jit, static_argnames=("step",))
+def _scan(step, args, carry, rows):
+    def one(carry, row):
+        new, out = step(args, carry, row)
+        return same_types(new, carry), out
+    return jax.lax.scan(one, carry, rows)
+
+
+def run_scan(step, args, carry, rows):
+    """step(args, carry, row) -> (carry, out) over the rows, SCAN_CHUNK rows per compiled run
+    (the last chunk padded with copies of the last row, its extra outputs dropped); returns
+    the outputs stacked (numpy)."""
+    count = jax.tree_util.tree_leaves(rows)[0].shape[0]
+    pad = lambda x: np.concatenate([x, np.repeat(x[-1:], -count % SCAN_CHUNK, axis=0)])
+    rows = jax.tree_util.tree_map(lambda x: pad(np.asarray(x)), rows)
+    carry, outs = host_state(carry), []
+    for first in range(0, count + (-count % SCAN_CHUNK), SCAN_CHUNK):
+        chunk = jax.tree_util.tree_map(lambda x: x[first: first + SCAN_CHUNK], rows)
+        carry, out = _scan(step, args, carry, chunk)
+        outs.append(jax.device_get(out))
+    return jax.tree_util.tree_map(lambda *parts: np.concatenate(parts)[:count], *outs)

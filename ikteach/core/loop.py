@@ -1,0 +1,79 @@
+"""The IK loop of lecture 05: repeat theta <- theta + delta_theta until a stop rule fires.
+
+Each pass, at the current theta:
+  1. e = target - F(theta) and J(theta);
+  2. the stops, checked before any step is taken: "diverged" (||e|| not finite), "converged"
+     (||e|| < tol), "stalled" or "slow" (the last step was smaller than stall_tol), "max_iter";
+  3. otherwise delta_theta = cap(method's step(J, clamp(e))), theta <- theta + delta_theta,
+     kept within the joint limits.
+
+`ik_loop` below is the whole loop in plain Python; ik.solve, ik.solve_batch and ik.track run
+the same `iterate`, compiled (jax.lax.while_loop, jax.vmap) by ikteach/_runtime/engine.py.
+"""
+from typing import NamedTuple
+
+import jax.numpy as jnp
+
+from .safeguards import cap_step, clamp_error
+from .stop_rules import step_size, still_progressing
+
+# What each status means (append only):
+#   converged  ||e|| < tol.
+#   stalled    the steps stopped moving the end effector at a minimum of ||e||: out of reach.
+#   max_iter   max_iter steps taken and no other stop fired (e.g. the pseudoinverse out of
+#              reach: it never settles).
+#   diverged   a non-finite error or step (the last finite theta is kept).
+#   slow       the stall rule fired, but ||e|| still fell by a steady fraction per step.
+#   singular   stalled at a saddle of ||e|| (a singular pose whose error J cannot see).
+#   damped     stalled while J still sees the error: damping, max_step or clamp cut the steps.
+# (singular and damped are told apart from stalled after the loop: ikteach/core/stop_rules.py.)
+STATUSES = ("running", "converged", "stalled", "max_iter", "diverged", "slow", "singular",
+            "damped")
+RUNNING, CONVERGED, STALLED, MAX_ITER, DIVERGED, SLOW, SINGULAR, DAMPED = range(8)
+
+
+class State(NamedTuple):
+    """Where the loop is: i steps taken, theta, ||e|| and the size of the last step."""
+    i: int
+    theta: jnp.ndarray
+    error: float
+    step: float
+    status: int
+
+
+def start(theta0):
+    """The state before the first pass (no error seen, no step taken yet)."""
+    return State(i=0, theta=theta0, error=jnp.inf, step=jnp.inf, status=RUNNING)
+
+
+def stop_rule(options, state, error):
+    """The stops in the order they are checked; RUNNING when none fires."""
+    stalled = (state.i > 0) & (state.step < options.stall_tol)
+    status = jnp.where(state.i >= options.max_iter, MAX_ITER, RUNNING)
+    status = jnp.where(stalled, jnp.where(still_progressing(state.error, error), SLOW, STALLED),
+                       status)
+    status = jnp.where(error < options.tol, CONVERGED, status)
+    return jnp.where(jnp.isfinite(error), status, DIVERGED)
+
+
+def iterate(problem, method, options, state):
+    """One pass of the loop: look at e, then stop or take one step."""
+    e, J = problem.error_and_jacobian(state.theta)
+    error = jnp.linalg.norm(e)
+    status = stop_rule(options, state, error)
+    e_seen = clamp_error(e, options.clamp, problem.rows_per_effector(e.shape[0]))
+    delta = method.delta(problem, state.theta, e_seen, J)
+    delta = cap_step(delta, options.max_step)
+    theta = jnp.clip(state.theta + delta, *options.joint_limits)
+    status = jnp.where((status == RUNNING) & ~jnp.all(jnp.isfinite(theta)), DIVERGED, status)
+    moving = status == RUNNING
+    return State(state.i + moving, jnp.where(moving, theta, state.theta), error,
+                 jnp.where(moving, step_size(options.stop_rule, J, delta), state.step), status)
+
+
+def ik_loop(problem, method, options, theta0):
+    """The whole loop, one Python iteration per pass (what the compiled engine runs too)."""
+    state = start(theta0)
+    while state.status == RUNNING:
+        state = iterate(problem, method, options, state)
+    return state
