@@ -23,7 +23,7 @@ def methods(tree_name):
 def run(tree_name, steps, warmup, **kw):
     make, targets_at = TREES[tree_name]
     res = ik.track(make(), targets_at(bt.times(warmup + steps)), **kw)
-    measured = ik.TrackResult(res.theta[warmup:], res.error[warmup:])
+    measured = ik.core.track.TrackResult(res.theta[warmup:], res.error[warmup:])
     return measured
 
 
@@ -62,7 +62,7 @@ if __name__ == "__main__":
     a = ap.parse_args()
     print(f"Buss's protocol: {a.warmup} warm-up steps, then {a.steps} measured steps of T = 0.005")
     print("mean error = mean over steps of sum_k |t_k - x_k|; "
-          "jitter = ik.jitter: mean over steps of sum_j |theta_j(t+1) - 2 theta_j(t) + theta_j(t-1)|\n")
+          "jitter = ik.core.jitter.jitter: mean over steps of sum_j |theta_j(t+1) - 2 theta_j(t) + theta_j(t-1)|\n")
     print_method_table(method_table(a.steps, a.warmup))
     print()
     print_damping_table(damping_table("double_y", [0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.5], a.steps, a.warmup),

@@ -1,5 +1,5 @@
 """Foot planting on the shipped walk clip (150 frames, 2 feet): time to clean the whole clip
-with ik.clip_ik.solve_clip after compiling (the goal: under 1 s), and the skate before/after.
+with ik.characters.clip_ik.solve_clip after compiling (the goal: under 1 s), and the skate before/after.
 
     python benchmarks/footplant.py [--repeat 20]
 """

@@ -5,7 +5,7 @@ after the first of their shape (which compiles), and how long the first one took
                                            [--skip-new-kernel]
 
 Rows: ik.solve on the 3-link planar arm for each method over random targets (some out
-of reach) with varied damping, tolerance and clamp; ik.demo.Demo().update(x=..., y=...)
+of reach) with varied damping, tolerance and clamp; ik.pictures.demo.Demo().update(x=..., y=...)
 per method (solve + PNG render); the notebook-07 live map (128 x 128 solve_batch + redraw)
 per method and lambda; the first solve per method in a new process with the compilation
 cache warm, with and without the program store.
@@ -70,9 +70,9 @@ def solve_rows(arm, n, rng):
 
 
 def demo_rows(n, rng):
-    header(f"ik.demo.Demo().update(x=..., y=...), solve + PNG render, {n} slider moves")
+    header(f"ik.pictures.demo.Demo().update(x=..., y=...), solve + PNG render, {n} slider moves")
     t0 = time.perf_counter()
-    demo = ik.demo.Demo()
+    demo = ik.pictures.demo.Demo()
     built = time.perf_counter() - t0
     for method in demo.method.options:
         first = timed(lambda: demo.update(method=method))

@@ -30,7 +30,7 @@ def scene_image(theta=SCENE_THETA, colors=None):
     try:
         if colors:
             scene.COLORS.update(colors)
-        arm = ik.ur5()
+        arm = ik.core.robots.ur5()
         target = np.asarray(ik.fk_pose(arm, SCENE_THETA + 0.25))
         p = scene.scene(arm, theta, target=target)
         image = scene.render(p)

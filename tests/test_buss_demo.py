@@ -18,7 +18,7 @@ def test_soft_sdls_rescales_every_direction_by_gamma_over_gamma_plus_max():
     rng = np.random.default_rng(1)
     J, e = rng.normal(size=(6, 7)), rng.normal(size=6)
     U, s, Vt = np.linalg.svd(J, full_matrices=False)
-    gamma = np.asarray(ik.sdls.sdls_gamma(U, s, Vt, J, GAMMA_MAX, 3))
+    gamma = np.asarray(ik.core.sdls.sdls_gamma(U, s, Vt, J, GAMMA_MAX, 3))
     total = np.zeros(7)
     for i in range(6):  # Jacobian.cpp's loop, written out
         w = (U[:, i] @ e) / s[i] * Vt[i]

@@ -118,7 +118,7 @@ def test_a_ball_joint_is_three_revolute_axes_in_channel_order(tmp_path):
     (tmp_path / "odd.bvh").write_text(ODD)
     sk, _ = bvh.load(tmp_path / "odd.bvh")
     rig = sk.rig()
-    assert isinstance(rig.tree, ik.Tree) and rig.tree.n_joints == 3 + 3 + 2
+    assert isinstance(rig.tree, ik.core.tree.Tree) and rig.tree.n_joints == 3 + 3 + 2
     np.testing.assert_allclose(rig.tree.axes[:8], [[1, 0, 0], [0, 1, 0], [0, 0, 1],   # pelvis XYZ
                                                    [0, 1, 0], [0, 0, 1], [1, 0, 0],   # thigh YZX
                                                    [1, 0, 0], [0, 0, 1]])             # shin XZ
@@ -131,8 +131,8 @@ def test_rig_jacobian_agrees_with_autodiff(clip):
     sk, motion = clip
     rig = skeleton.rig(sk, ["LeftFoot", "RightHand_end", "Head_end"])
     _, theta = skeleton.angles(rig, motion.frames)
-    np.testing.assert_allclose(ik.tree_jacobian(rig.tree, theta[40]),
-                               ik.tree_jacobian_autodiff(rig.tree, theta[40]), atol=1e-8)
+    np.testing.assert_allclose(ik.core.tree.tree_jacobian(rig.tree, theta[40]),
+                               ik.core.tree.tree_jacobian_autodiff(rig.tree, theta[40]), atol=1e-8)
 
 
 def test_frames_from_inverts_angles(clip):

@@ -17,7 +17,7 @@ def test_ccd_angle_turns_a_point_onto_the_targets_ray(phi, radius, height):
     w = np.array([0.0, 0.0, 1.0])
     x = np.array([1.0, 0.0, 0.3])
     t = np.array([radius * np.cos(phi), radius * np.sin(phi), height])
-    angle = float(ik.ccd_angle(w, np.zeros(3), x, t))
+    angle = float(ik.core.ccd.ccd_angle(w, np.zeros(3), x, t))
     assert angle == pytest.approx(phi, abs=1e-9) or abs(abs(phi) - np.pi) < 1e-9
 
 
@@ -47,7 +47,7 @@ def test_stalls_out_of_reach_stretched_toward_the_target(method, target):
 @given(arm_and_angles(planar_arms(min_joints=2)), st.floats(-4, 4), st.floats(-4, 4))
 def test_fabrik_pass_keeps_link_lengths_and_base(case, tx, ty):
     arm, theta = case
-    points = np.asarray(ik.joint_frames(arm, theta)[0])
+    points = np.asarray(ik.core.kinematics.joint_frames(arm, theta)[0])
     lengths = np.linalg.norm(arm.offsets, axis=1)
     new = np.asarray(fabrik_pass(points, lengths, np.array([tx, ty, 0.0])))
     np.testing.assert_allclose(np.linalg.norm(np.diff(new, axis=0), axis=1), lengths, atol=1e-9)
@@ -59,7 +59,7 @@ def test_one_ccd_sweep_never_moves_the_tip_away(case, tx, ty):
     arm, theta = case
     target = np.array([tx, ty])
     before = np.linalg.norm(np.asarray(ik.fk(arm, theta)) - target)
-    after = np.linalg.norm(np.asarray(ik.fk(arm, ik.ccd_sweep(arm, target, theta))) - target)
+    after = np.linalg.norm(np.asarray(ik.fk(arm, ik.core.ccd.ccd_sweep(arm, target, theta))) - target)
     assert after <= before + 1e-9
 
 
@@ -72,7 +72,7 @@ def test_batch_runs_ccd_and_fabrik():
 
 
 def test_ccd_and_fabrik_refuse_trees():
-    Y = ik.buss_trees.y_tree()
+    Y = ik.core.buss_trees.y_tree()
     for method in ("ccd", "fabrik"):
         with pytest.raises(ValueError, match="method"):
             ik.solve(Y, np.zeros((2, 3)), np.zeros(7), method=method)
@@ -81,7 +81,7 @@ def test_ccd_and_fabrik_refuse_trees():
 def test_fabrik_pass_keeps_link_lengths_when_points_coincide():
     # straight arm, target on the base: the forward pass lands a joint on the next one
     arm = ik.planar_chain([1.0, 1.0, 1.0])
-    points = np.asarray(ik.joint_frames(arm, np.zeros(3))[0])
+    points = np.asarray(ik.core.kinematics.joint_frames(arm, np.zeros(3))[0])
     new = np.asarray(fabrik_pass(points, np.ones(3), np.zeros(3)))
     np.testing.assert_allclose(np.linalg.norm(np.diff(new, axis=0), axis=1), [1.0, 1.0, 1.0])
     np.testing.assert_allclose(new[0], points[0])

@@ -134,7 +134,7 @@ def test_a_trace_across_chunks_is_the_trace_of_one_long_run(method):
 
 def test_new_pose_weights_compile_nothing_new():
     """PoseTask's weights are traced data: a new (position, orientation) pair reuses the loop."""
-    ur5 = ik.ur5()
+    ur5 = ik.core.robots.ur5()
     target = np.asarray(ik.fk_pose(ur5, np.full(6, 0.4)))
     kw = dict(tol=1e-3, damping=0.5)  # absolute: the defaults scale with the UR5's reach (1.19)
     first = ik.solve(ur5, target, np.zeros(6), weights=(1.0, 0.5), **kw)

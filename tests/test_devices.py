@@ -16,7 +16,7 @@ SPLIT_CHECK = textwrap.dedent("""
     ik.notebook.compilation_cache()  # the tests' folder ($IKTEACH_JAX_CACHE), as in conftest
     assert len(jax.devices()) == 3, jax.devices()
     rng = np.random.default_rng(1)
-    arm, ur5 = ik.planar_chain([1.0, 0.8, 0.5]), ik.ur5()
+    arm, ur5 = ik.planar_chain([1.0, 0.8, 0.5]), ik.core.robots.ur5()
     planar = rng.uniform(-2.6, 2.6, size=(1001, 2))   # 1001 = 3 x 333 + 2: padded shares
     poses = np.stack([np.asarray(ik.fk_pose(ur5, q)) for q in rng.uniform(-1, 1, size=(40, 6))])
     cases = [(arm, planar, np.array([0.3, 0.2, 0.1]), dict(method="dls", damping=0.3)),

@@ -36,7 +36,7 @@ def test_dls_step_equals_the_normal_equations():
         e = RNG.normal(size=2)
         np.testing.assert_allclose(ik.dls_step(J, e, 0.5), ik.dls_step_normal(J, e, 0.5),
                                    atol=1e-12)
-    J = np.asarray(ik.jacobian(ik.ur5(), RNG.normal(size=6)))  # m = 3: the adjugate
+    J = np.asarray(ik.jacobian(ik.core.robots.ur5(), RNG.normal(size=6)))  # m = 3: the adjugate
     e = RNG.normal(size=3)
     np.testing.assert_allclose(ik.dls_step(J, e, 0.3), ik.dls_step_normal(J, e, 0.3), atol=1e-12)
 
@@ -46,7 +46,7 @@ def one_walk(task, arm, target, theta):
     return e, linearized.jacobian(arm, theta)
 
 
-@pytest.mark.parametrize("arm", [ik.planar_chain([1.0, 0.7, 0.4], base=(0.2, -0.1)), ik.ur5()],
+@pytest.mark.parametrize("arm", [ik.planar_chain([1.0, 0.7, 0.4], base=(0.2, -0.1)), ik.core.robots.ur5()],
                          ids=["planar", "ur5"])
 def test_one_walk_of_the_chain_gives_the_same_e_and_J_as_two(arm):
     task = PositionTask()

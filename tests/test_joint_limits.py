@@ -132,17 +132,15 @@ def test_limits_with_a_user_step_run_eagerly():
 
 
 def test_limits_on_a_built_in_method_are_compiled_without_a_trial_trace(monkeypatch):
-    """Joint limits wrap the method; a wrapped built-in is still known to be JAX code, so the
-    solve goes straight to the compiled loop (only a user's step is tried by tracing it)."""
-    import importlib
+    """The clamping loop around a built-in is JAX code (is_jax), so the solve goes straight to
+    the compiled loop; around a user's step function it is tried by tracing it."""
+    from ikteach.core import methods
+    from ikteach.core.joint_limits import ClampingLoop
 
-    solve_module = importlib.import_module("ikteach.core.methods")
-    from ikteach.core.joint_limits import LimitedMethod
-
-    assert solve_module.built_in(LimitedMethod(solve_module.METHODS["pinv"], "clamp"))
-    assert not solve_module.built_in(LimitedMethod(solve_module.resolve_method(lambda J, e: e), "clamp"))
+    assert ClampingLoop(ik.Pinv(), 0.0, 1.0, np.inf).is_jax
+    assert not ClampingLoop(methods.as_method(lambda J, e: e), 0.0, 1.0, np.inf).is_jax
     tried = []
-    monkeypatch.setattr(solve_module.jax, "eval_shape", lambda *a, **k: tried.append(1))
+    monkeypatch.setattr(methods.jax, "eval_shape", lambda *a, **k: tried.append(1))
     arm = ik.planar_chain([1.0, 1.0, 1.0])
     for mode in MODES:
         ik.solve(arm, [0.5, 1.5], np.zeros(3), method="dls", joint_limits=(np.full(3, -1.0), np.ones(3)),

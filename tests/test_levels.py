@@ -12,7 +12,7 @@ START = np.full(4, 0.1)
 
 
 def distances(theta, targets):
-    return np.linalg.norm(np.asarray(ik.tree_fk(ARM, theta)) - targets, axis=1)
+    return np.linalg.norm(np.asarray(ik.core.tree.tree_fk(ARM, theta)) - targets, axis=1)
 
 
 @pytest.mark.parametrize("levels, winner", [((0, 1), 0), ((1, 0), 1)])

@@ -43,7 +43,7 @@ def test_live_map_recomputes_on_a_new_lambda_and_keeps_a_png():
     assert not np.array_equal(live.result.iterations, before)
     live.update(method="jt", quantity="status")
     assert live.result.method == "jt"
-    assert ik.live_map is live_map  # lazy attribute of the package
+    assert ik.pictures.live_map is live_map  # lazy attribute of the package
 
 
 @pytest.fixture

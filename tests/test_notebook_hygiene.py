@@ -250,7 +250,7 @@ def test_every_img_and_gif_says_what_it_shows(path):
     for i, cell in enumerate(nb["cells"]):
         for output in cell.get("outputs", []):
             assert "image/gif" not in output.get("data", {}), \
-                f"{path.name} cell {i}: a bare GIF (no alt): show it with ik.plot.gif_view"
+                f"{path.name} cell {i}: a bare GIF (no alt): show it with ik.pictures.plot.gif_view"
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.relative_to(ROOT).as_posix())

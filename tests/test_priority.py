@@ -95,7 +95,7 @@ def test_damping_shrinks_the_step_near_a_singular_primary():
 def test_multilevel_with_two_levels_is_the_priority_step():
     rng = np.random.default_rng(3)
     J1, J2, e1, e2 = rng.normal(size=(2, 6)), rng.normal(size=(3, 6)), rng.normal(size=2), rng.normal(size=3)
-    np.testing.assert_allclose(ik.multilevel_step([(J1, e1), (J2, e2)], 0.2),
+    np.testing.assert_allclose(ik.core.priority.multilevel_step([(J1, e1), (J2, e2)], 0.2),
                                ik.priority_step(J1, e1, J2, e2, 0.2), atol=1e-12)
 
 
@@ -103,8 +103,8 @@ def test_third_level_does_not_disturb_the_first_two():
     rng = np.random.default_rng(4)
     J1, J2, J3 = rng.normal(size=(2, 7)), rng.normal(size=(2, 7)), np.eye(7)
     e1, e2, e3 = rng.normal(size=2), rng.normal(size=2), rng.normal(size=7)
-    two = np.asarray(ik.multilevel_step([(J1, e1), (J2, e2)], 0.0))
-    three = np.asarray(ik.multilevel_step([(J1, e1), (J2, e2), (J3, e3)], 0.0))
+    two = np.asarray(ik.core.priority.multilevel_step([(J1, e1), (J2, e2)], 0.0))
+    three = np.asarray(ik.core.priority.multilevel_step([(J1, e1), (J2, e2), (J3, e3)], 0.0))
     np.testing.assert_allclose(J1 @ three, J1 @ two, atol=1e-10)
     np.testing.assert_allclose(J2 @ three, J2 @ two, atol=1e-10)
     assert not np.allclose(three, two)

@@ -8,14 +8,14 @@ from ikteach.core import robots
 
 def test_ur5_home_position_matches_the_published_dh_numbers():
     # At theta = 0 the UR5 lies stretched: x = a2 + a3, y = -(d4 + d6), z = d1 - d5.
-    np.testing.assert_allclose(np.asarray(ik.fk(ik.ur5(), np.zeros(6))),
+    np.testing.assert_allclose(np.asarray(ik.fk(ik.core.robots.ur5(), np.zeros(6))),
                                [-0.425 - 0.39225, -(0.10915 + 0.0823), 0.089159 - 0.09465], atol=1e-12)
 
 
 def test_iiwa14_home_is_straight_up():
-    np.testing.assert_allclose(np.asarray(ik.fk(ik.iiwa14(), np.zeros(7))),
+    np.testing.assert_allclose(np.asarray(ik.fk(ik.core.robots.iiwa14(), np.zeros(7))),
                                [0.0, 0.0, 0.36 + 0.42 + 0.4 + 0.126], atol=1e-12)
-    assert ik.iiwa14().n_joints == 7 and ik.ur5().n_joints == 6
+    assert ik.core.robots.iiwa14().n_joints == 7 and ik.core.robots.ur5().n_joints == 6
 
 
 @pytest.mark.parametrize("name", sorted(robots.ROBOTS))

@@ -39,7 +39,7 @@ def test_changing_a_colour_fails_the_comparison(reference):
 
 
 def test_arm_meshes_sit_on_the_joints():
-    arm = ik.iiwa14()
+    arm = ik.core.robots.iiwa14()
     theta = np.linspace(-0.5, 0.7, 7)
     positions, axes, T = scene.frames(arm, theta)
     parts = scene.arm_meshes(arm, theta)
@@ -59,7 +59,7 @@ def test_a_moved_scene_looks_like_one_built_at_the_new_pose(reference):
     import pyvista as pv
 
     pv.OFF_SCREEN = True
-    arm = ik.ur5()
+    arm = ik.core.robots.ur5()
     target = np.asarray(ik.fk_pose(arm, SCENE_THETA + 0.25))
     p, pose = scene._scene(arm, SCENE_THETA - 0.4, target, None, scene.WINDOW, None, None)
     assert ssim(reference, scene.render(p), crop_to=reference) < SCENE_SSIM  # not there yet
@@ -85,7 +85,7 @@ def test_turn_onto_takes_one_direction_onto_another(seed):
 def test_solve_gif_writes_frames(tmp_path, monkeypatch):
     import pyvista as pv
 
-    arm = ik.ur5()
+    arm = ik.core.robots.ur5()
     target = np.asarray(ik.fk_pose(arm, SCENE_THETA + 0.2))
     res = ik.solve(arm, target, SCENE_THETA, tol=1e-6, damping=0.05, max_iter=100)
     renders = []

@@ -35,7 +35,7 @@ def test_singular_direction_is_damped_not_blown_up():
     J = np.asarray(ik.jacobian(ARM, theta))
     e = np.array([0.5, 0.0])
     assert np.max(np.abs(ik.pinv_step(J, e))) > 10
-    assert np.max(np.abs(ik.sdls_step(J, e))) <= ik.GAMMA_MAX
+    assert np.max(np.abs(ik.sdls_step(J, e))) <= ik.core.sdls.GAMMA_MAX
 
 
 def test_solve_trace_respects_gamma_max():

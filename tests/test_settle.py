@@ -28,4 +28,4 @@ def test_the_threshold_grows_with_distance_and_the_clamp_caps_it():
 
 def test_settle_takes_planar_chains_only():
     with pytest.raises(ValueError, match="arm"):
-        settle.settle_factor(ik.ur5(), 0.5, 0.5)
+        settle.settle_factor(ik.core.robots.ur5(), 0.5, 0.5)

@@ -18,8 +18,8 @@ def test_import_loads_no_heavy_library():
 
 
 def test_lazy_modules_work_as_attributes():
-    code = ("import sys, ikteach as ik; ik.workspace.target_grid; ik.plot.draw_arm; "
-            "ik.demo.Demo; ik.scene.scene; ik.check; from ikteach import tree_plot; "
+    code = ("import sys, ikteach as ik; ik.pictures.workspace_maps.target_grid; ik.pictures.plot.draw_arm; "
+            "ik.pictures.demo.Demo; ik.pictures.scene.scene; ik.check; from ikteach import tree_plot; "
             "print('matplotlib' in sys.modules, sorted(set(ik.LAZY) - set(dir(ik))))")
     assert _run(code) == ["True", "[]"]
 

@@ -16,9 +16,9 @@ R2, H3 = 1 / np.sqrt(2), np.sqrt(3) / 2
 @given(random_trees(), st.integers(0, 2**31 - 1))
 def test_stacked_jacobian_agrees_with_autodiff_on_random_trees(arm, seed):
     theta = np.random.default_rng(seed).uniform(-np.pi, np.pi, arm.n_joints)
-    J = ik.tree_jacobian(arm, theta)
+    J = ik.core.tree.tree_jacobian(arm, theta)
     assert J.shape == (3 * arm.n_effectors, arm.n_joints)
-    np.testing.assert_allclose(J, ik.tree_jacobian_autodiff(arm, theta), atol=1e-10)
+    np.testing.assert_allclose(J, ik.core.tree.tree_jacobian_autodiff(arm, theta), atol=1e-10)
 
 
 def walk_joint_by_joint(arm, theta):
@@ -45,7 +45,7 @@ def test_the_level_by_level_walk_equals_the_joint_by_joint_walk(arm, seed):
     """tree_frames turns all joints of one depth at once; listed order, roots and depths mixed
     (FOREST: two roots, a joint listed after deeper ones) give the same frames."""
     theta = np.random.default_rng(seed).uniform(-np.pi, np.pi, arm.n_joints)
-    for ours, plain in zip(ik.tree_frames(arm, theta), walk_joint_by_joint(arm, theta)):
+    for ours, plain in zip(ik.core.tree.tree_frames(arm, theta), walk_joint_by_joint(arm, theta)):
         np.testing.assert_allclose(ours, plain, atol=1e-12)
 
 
@@ -57,13 +57,13 @@ def test_depth_levels_put_every_parent_one_level_up():
 @pytest.mark.parametrize("arm", [Y, DOUBLE_Y], ids=["Y", "double Y"])
 def test_buss_tree_jacobians_agree_with_autodiff(arm):
     theta = np.random.default_rng(1).uniform(-1, 1, arm.n_joints)
-    np.testing.assert_allclose(ik.tree_jacobian(arm, theta), ik.tree_jacobian_autodiff(arm, theta),
+    np.testing.assert_allclose(ik.core.tree.tree_jacobian(arm, theta), ik.core.tree.tree_jacobian_autodiff(arm, theta),
                                atol=1e-10)
 
 
 def test_y_tree_matches_the_published_rest_pose():
     # BuildTreeYShape: nodes 0-6 joints, 7-8 effectors
-    p, w, x = map(np.asarray, ik.tree_frames(Y, np.zeros(7)))
+    p, w, x = map(np.asarray, ik.core.tree.tree_frames(Y, np.zeros(7)))
     np.testing.assert_allclose(p, [[0, -.5, 0], [0, .4, 0], [0, .4, 0], [.5, 1, 0], [-.5, 1, 0],
                                    [.7, 1.3, 0], [-.8, 1.5, 0]])
     u1 = [np.sqrt(14) / 8, 1 / 8, 7 / 8]
@@ -74,16 +74,16 @@ def test_y_tree_matches_the_published_rest_pose():
 
 def test_y_tree_branches_each_move_only_their_own_effector():
     assert ancestors(Y).tolist() == [[1, 1, 0, 1, 0, 1, 0], [1, 0, 1, 0, 1, 0, 1]]
-    x0 = np.asarray(ik.tree_fk(Y, np.zeros(7)))
+    x0 = np.asarray(ik.core.tree.tree_fk(Y, np.zeros(7)))
     theta = np.zeros(7)
     theta[1] = np.pi / 2                 # left fork joint about z through (0, 0.4, 0)
-    x = np.asarray(ik.tree_fk(Y, theta))
+    x = np.asarray(ik.core.tree.tree_fk(Y, theta))
     np.testing.assert_allclose(x[1], x0[1], atol=1e-12)
     np.testing.assert_allclose(x[0], [0 - 1.6, 0.4 + 0.7, 0], atol=1e-12)  # (0.7, 1.6) turned 90°
 
 
 def test_double_y_tree_matches_the_published_rest_pose_and_structure():
-    p, w, x = map(np.asarray, ik.tree_frames(DOUBLE_Y, np.zeros(25)))
+    p, w, x = map(np.asarray, ik.core.tree.tree_frames(DOUBLE_Y, np.zeros(25)))
     assert DOUBLE_Y.n_joints == 25 and DOUBLE_Y.n_effectors == 4
     y0 = -0.5 + 0.5 * R2
     np.testing.assert_allclose(x, [[0.5 * R2 + 1.5 * H3, y0 + 0.75, 0], [0.5 * R2 + 1.5 * H3, y0 + 1.5 * H3, 0],
@@ -108,10 +108,10 @@ def test_targets_are_the_published_sums_of_sines():
 @pytest.mark.parametrize("method", ["dls", "sdls", "pinv"])
 def test_solve_reaches_one_target_per_effector(method):
     goal = np.random.default_rng(2).uniform(-0.6, 0.6, 25)
-    targets = np.asarray(ik.tree_fk(DOUBLE_Y, goal))
+    targets = np.asarray(ik.core.tree.tree_fk(DOUBLE_Y, goal))
     res = ik.solve(DOUBLE_Y, targets, np.zeros(25), method=method, damping=0.1, tol=1e-4, max_iter=2000)
     assert res.status == "converged", res
-    assert np.all(np.linalg.norm(np.asarray(ik.tree_fk(DOUBLE_Y, res.theta)) - targets, axis=1) < 1e-4)
+    assert np.all(np.linalg.norm(np.asarray(ik.core.tree.tree_fk(DOUBLE_Y, res.theta)) - targets, axis=1) < 1e-4)
 
 
 def test_out_of_reach_tree_targets_stall_without_nan():
@@ -124,7 +124,7 @@ def test_out_of_reach_tree_targets_stall_without_nan():
 
 def test_solve_batch_on_a_tree():
     rng = np.random.default_rng(4)
-    targets = np.stack([np.asarray(ik.tree_fk(Y, rng.uniform(-0.5, 0.5, 7))) for _ in range(3)])
+    targets = np.stack([np.asarray(ik.core.tree.tree_fk(Y, rng.uniform(-0.5, 0.5, 7))) for _ in range(3)])
     batch = ik.solve_batch(Y, targets, np.zeros(7), method="dls", damping=0.1, tol=1e-4, max_iter=2000)
     assert batch.counts()["converged"] == 3
 
@@ -136,7 +136,7 @@ def test_tracking_follows_the_y_targets():
     assert np.all(np.isfinite(res.theta))
     # target 0 is at times out of reach, so the error never reaches 0; but following the
     # targets must do far better than standing still in the rest pose
-    still = np.linalg.norm(targets - np.asarray(ik.tree_fk(Y, np.zeros(7))), axis=2).sum(axis=1)
+    still = np.linalg.norm(targets - np.asarray(ik.core.tree.tree_fk(Y, np.zeros(7))), axis=2).sum(axis=1)
     assert res.error.mean() < 0.4 * still.mean()
 
 
@@ -184,7 +184,7 @@ def test_error_and_jacobian_from_one_walk_equal_the_two_calls_to_the_bit(arm, ta
     changes jacobian() (clip_ik's mask) must change error_and_jacobian() too."""
     rng = np.random.default_rng(2)
     theta = rng.uniform(-1, 1, arm.n_joints)
-    target = np.asarray(ik.tree_fk(arm, rng.uniform(-1, 1, arm.n_joints)))
+    target = np.asarray(ik.core.tree.tree_fk(arm, rng.uniform(-1, 1, arm.n_joints)))
     if len(getattr(task, "mask", ())) not in (0, arm.n_joints):
         task = type(task)(mask=task.mask[: arm.n_joints])
     e, J = task.error_and_jacobian(arm, target, theta)

@@ -65,7 +65,7 @@ matplotlib.use("Agg")
 from matplotlib.figure import Figure
 fig = Figure()
 ax = fig.subplots()
-ik.plot.draw_arm(ax, arm, res.theta)
+ik.pictures.plot.draw_arm(ax, arm, res.theta)
 fig.savefig("arm.png")
 assert Path("arm.png").stat().st_size > 1000
 print("plot: arm.png")
@@ -73,9 +73,9 @@ print("plot: arm.png")
 if "--scene" in sys.argv:
     import pyvista as pv
     pv.OFF_SCREEN = True
-    ur5 = ik.ur5()
-    p = ik.scene.scene(ur5, np.zeros(6))
-    image = ik.scene.render(p)
+    ur5 = ik.core.robots.ur5()
+    p = ik.pictures.scene.scene(ur5, np.zeros(6))
+    image = ik.pictures.scene.render(p)
     p.close()
     assert image.ndim == 3 and image.std() > 1.0, "blank scene"
     print("scene:", image.shape)
@@ -84,7 +84,7 @@ if "--probe" in sys.argv:
     print("data:", importlib.resources.files("ikteach").joinpath(sys.argv[-1]).read_text().strip())
 
 if "--demo" in sys.argv:
-    demo = ik.demo.Demo()
+    demo = ik.pictures.demo.Demo()
     demo.update(x=3.5, y=1.0)
     import ipywidgets
     print("demo:", ipywidgets.__version__, demo.result.status)

@@ -35,7 +35,7 @@ def test_grid_layout_rows_are_y():
     assert img.shape == (8, 8, 2)
     assert np.all(np.diff(img[:, 0, 1]) > 0) and np.all(np.diff(img[0, :, 0]) > 0)
     with pytest.raises(ValueError, match="arm"):
-        ws.target_grid(ik.ur5(), 8)
+        ws.target_grid(ik.core.robots.ur5(), 8)
     with pytest.raises(ValueError, match="n"):
         ws.target_grid(arm, 1)
 

@@ -16,7 +16,7 @@ from importlib import resources
 import numpy as np
 
 from ..core._validate import as_array
-from .skeleton import POSITIONS, ROTATIONS, Skeleton  # noqa: F401  (ik.bvh.Skeleton)
+from .skeleton import POSITIONS, ROTATIONS, Skeleton  # noqa: F401  (ik.characters.bvh.Skeleton)
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -169,9 +169,9 @@ def format_bvh(skeleton, motion):
 def save(path, skeleton, motion):
     """Write skeleton and motion as a BVH file; returns the path."""
     if not isinstance(skeleton, Skeleton):
-        raise ValueError(f"skeleton: expected an ik.bvh.Skeleton, got {type(skeleton).__name__}")
+        raise ValueError(f"skeleton: expected an ik.characters.bvh.Skeleton, got {type(skeleton).__name__}")
     if not isinstance(motion, Motion):
-        raise ValueError(f"motion: expected an ik.bvh.Motion, got {type(motion).__name__}")
+        raise ValueError(f"motion: expected an ik.characters.bvh.Motion, got {type(motion).__name__}")
     text = format_bvh(skeleton, motion)
     with open(path, "w", encoding="utf-8") as f:
         f.write(text)

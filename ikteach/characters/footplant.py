@@ -7,7 +7,7 @@ clean a clip with IK so that planted feet stay put.
 3. targets:   in each contact interval the foot aims at one point, the mean of where it was;
    between contacts the correction (target - foot) is interpolated, so the targets glide.
 4. clean:     frame by frame, the solve loop (DLS) moves only the hips, knees and ankle hinges
-   to put the feet on their targets (ik.clip_ik.solve_clip), warm-started from the previous
+   to put the feet on their targets (ik.characters.clip_ik.solve_clip), warm-started from the previous
    frame. Each toe (the foot's end site) aims at its ankle's target plus the clip's own
    ankle-to-toe vector, so the foot keeps the clip's orientation instead of pitching as the
    knee bends; every target is lifted to stay on or above the floor.
@@ -90,7 +90,7 @@ def retarget(skeleton, motion, scales):
     along the ground kept. Longer legs then take longer strides than the body travels: the
     planted feet skate."""
     if not isinstance(skeleton, Skeleton):
-        raise ValueError(f"skeleton: expected an ik.bvh.Skeleton, got {type(skeleton).__name__}")
+        raise ValueError(f"skeleton: expected an ik.characters.bvh.Skeleton, got {type(skeleton).__name__}")
     if not isinstance(scales, dict) or not scales:
         raise ValueError(f"scales: expected a dict {{joint name: factor}}, got {scales!r:.80}")
     offsets = skeleton.offsets.copy()

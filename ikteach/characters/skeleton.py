@@ -52,7 +52,7 @@ class Skeleton:
         return {c: start + i for i, c in enumerate(self.channels[j])}
 
     def rig(self, points=None):
-        """The skeleton as an IK tree (ik.skeleton.rig): rig.tree is an ik.Tree with end effectors
+        """The skeleton as an IK tree (ik.characters.skeleton.rig): rig.tree is an ik.core.tree.Tree with end effectors
         at the named points (default: every joint and end site)."""
         return rig(self, points)
 
@@ -64,7 +64,7 @@ class Skeleton:
 class Rig:
     """A skeleton's IK tree and how its revolute joints map back to the skeleton.
 
-    tree           the ik.Tree (end effectors = the named points);
+    tree           the ik.core.tree.Tree (end effectors = the named points);
     points         names of the end effectors (joint names, or "<joint>_end" for an end site);
     joint_of[i]    the skeleton joint that revolute i belongs to;
     column_of[i]   the motion column (channel) of revolute i;
@@ -149,7 +149,7 @@ def rig(skeleton, points=None):
             (joint, offset) pairs (a point fixed to the joint, offset in the rest pose, e.g. the eyes).
     """
     if not isinstance(skeleton, Skeleton):
-        raise ValueError(f"skeleton: expected an ik.bvh.Skeleton, got {type(skeleton).__name__}")
+        raise ValueError(f"skeleton: expected an ik.characters.bvh.Skeleton, got {type(skeleton).__name__}")
     points = all_points(skeleton) if points is None else tuple(points)
     if not points:
         raise ValueError("points: expected a non-empty list of joint names, got none")

@@ -48,6 +48,7 @@ def require_chain(arm, name):
 class CCD:
     """CCD as a solve method: delta_theta = (theta after one sweep) - theta."""
     uses_jacobian = False
+    is_jax = True
 
     def delta(self, problem, theta, e, J, free=None):
         return ccd_sweep(problem.arm, problem.target, theta) - theta

@@ -77,6 +77,7 @@ def angles_toward_points(arm, theta, points):
 class FABRIK:
     """FABRIK as a solve method: one pass on the points, then back to angles."""
     uses_jacobian = False
+    is_jax = True
 
     def delta(self, problem, theta, e, J, free=None):
         arm = problem.arm

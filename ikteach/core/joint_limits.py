@@ -77,6 +77,10 @@ class ClampingLoop:
     max_step: float
     uses_jacobian = True
 
+    @property
+    def is_jax(self):
+        return self.inner.is_jax
+
     def delta(self, problem, theta, e, J, free=None):
         def solve_free(J_free, e_rest, free):
             return self.inner.delta(problem, theta, e_rest, J_free, free)

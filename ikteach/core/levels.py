@@ -3,7 +3,7 @@
 levels[k] is the priority of the k-th block of the target (0 first): one block per end
 effector for a tree, the position and the orientation for a 4x4 pose target, the whole
 target for a point on a chain. Each level is solved in the null space of all the levels
-before it (ik.multilevel_step), so e.g. feet (level 0) stay planted while a hand (level 1)
+before it (ik.core.priority.multilevel_step), so e.g. feet (level 0) stay planted while a hand (level 1)
 reaches as far as the feet allow. rest_pose adds one last level, e = gain (theta_rest - theta)
 with J = I: with the freedom that is still left, drift back towards a preferred pose.
 
@@ -57,7 +57,7 @@ def with_priorities(method, problem, theta0, options):
         return method
     if getattr(method, "damping", None) is None:
         raise ValueError("method: levels= and rest_pose= use the damped priority step "
-                         "(ik.multilevel_step with damping=); use method='dls' or ik.DLS(damping)")
+                         "(ik.core.priority.multilevel_step with damping=); use method='dls' or ik.DLS(damping)")
     rows = jax.eval_shape(problem.error, theta0).shape[0]
     block = block_size(problem.task, rows)
     blocks = rows // block

@@ -12,6 +12,7 @@ method = pytree_dataclass  # @method(data=("damping",)) class DLS(JacobianMethod
 class JacobianMethod:
     """Base of the methods that turn (J, e) into a step."""
     uses_jacobian = True
+    is_jax = True  # written with jax.numpy: compiled without a trial trace
 
     def step(self, J, e):
         raise NotImplementedError

@@ -21,6 +21,7 @@ METHODS = {"jt": JT, "pinv": Pinv, "dls": DLS, "sdls": SDLS, "ccd": CCD, "fabrik
 class StepFunction(JacobianMethod):
     """A step function step(J, e) -> delta_theta given by the user."""
     fn: Callable
+    is_jax = False  # numpy, float(), branches on values: tried before compiling
 
     def step(self, J, e):
         return check_step(self.fn(J, e))
@@ -47,31 +48,19 @@ def method_parameters(cls):
     return tuple(getattr(cls, "__dataclass_fields__", {}))
 
 
-def named(method, **parameters):
-    """The method called `method` with those of `parameters` it owns: a control panel's lambda
-    reaches DLS and not JT. A method object or step function is returned as it is."""
-    if not isinstance(method, str) or method not in METHODS:
-        return as_method(method)
-    owned = method_parameters(METHODS[method])
-    return as_method(method, **{k: v for k, v in parameters.items() if k in owned})
-
-
 def as_method(method, **parameters):
-    """A method object from a name (with its parameters), an object, or a step function.
+    """A method object from a name, an object, or a step function.
 
-    A parameter the method does not own (damping for "jt") is a ValueError naming it."""
+    With a name, each parameter given goes to the method if it owns it (damping reaches DLS;
+    "jt" has none and ignores it), so one set of keywords serves a loop over method names."""
     if isinstance(method, str):
         if method not in METHODS:
             raise ValueError(f"method: expected one of {sorted(METHODS)}, a method object such "
                              f"as ik.DLS(damping=0.2), or a function step(J, e) -> delta_theta, "
                              f"got {method!r:.80}")
         cls = METHODS[method]
-        given = {k: v for k, v in parameters.items() if v is not None}
-        stray = sorted(set(given) - set(method_parameters(cls)))
-        if stray:
-            raise ValueError(f"{stray[0]}: method {method!r} has no parameter {stray[0]!r} "
-                             f"(its parameters: {list(method_parameters(cls)) or 'none'})")
-        return cls(**given)
+        return cls(**{k: v for k, v in parameters.items()
+                      if v is not None and k in method_parameters(cls)})
     if any(v is not None for v in parameters.values()):
         name = next(k for k, v in parameters.items() if v is not None)
         raise ValueError(f"{name}: give it to the method object (e.g. ik.DLS(damping=...)), "
@@ -91,7 +80,10 @@ def as_method(method, **parameters):
 
 
 def traceable(method, problem, theta0):
-    """Can JAX trace the method's step here (pure jax.numpy), or must it run eagerly?"""
+    """Can JAX trace the method's step here (pure jax.numpy), or must it run eagerly?
+    Methods written in JAX say so (is_jax); a user's step function is tried."""
+    if method.is_jax:
+        return True
     try:
         jax.eval_shape(lambda q: method.delta(problem, q, problem.error(q), problem.jacobian(q)),
                        theta0)
@@ -104,6 +96,8 @@ def traceable(method, problem, theta0):
 
 def require_traceable(method, problem, theta0, caller):
     """A ValueError naming `method` when `caller` (which compiles the step) cannot trace it."""
+    if method.is_jax:
+        return
     try:
         jax.eval_shape(lambda q: method.delta(problem, q, problem.error(q), problem.jacobian(q)),
                        theta0)

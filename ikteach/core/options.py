@@ -119,8 +119,8 @@ def check_limits(joint_limits):
     try:
         lower, upper = np.broadcast_arrays(*out)
     except ValueError:
-        raise ValueError(f"joint_limits: lower and upper have different lengths "
-                         f"({out[0].shape} and {out[1].shape})") from None
+        raise ValueError(f"joint_limits: expected lower and upper of the same length, got "
+                         f"shapes {out[0].shape} and {out[1].shape}") from None
     if np.any(lower > upper):
         j = int(np.argmax(lower > upper))
         raise ValueError(f"joint_limits: expected lower <= upper, got lower[{j}] = {lower[j]} "

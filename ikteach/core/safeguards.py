@@ -2,14 +2,13 @@
 import jax.numpy as jnp
 
 
-def clamp_error(e, d_max, rows=None):
+def clamp_error(e, d_max):
     """Clamp |e| to at most D_max: e <- D_max e / |e| when |e| > D_max (D_max = inf: no clamp).
 
-    With rows (the rows per end effector of a tree), each effector's part of e is clamped by
-    itself, as Buss does; d_max may then hold one D_max per effector.
+    d_max may hold one D_max per end effector (Buss's tracking demo): e is then cut into that
+    many equal parts, each clamped by itself.
     """
-    rows = e.shape[0] if rows is None else rows
-    parts = e.reshape(-1, rows)
+    parts = e.reshape(jnp.size(d_max), -1)
     norm = jnp.linalg.norm(parts, axis=1, keepdims=True)
     d_max = jnp.reshape(d_max, (-1, 1))
     scale = jnp.where(norm > d_max, d_max / jnp.where(norm > 0, norm, 1.0), 1.0)

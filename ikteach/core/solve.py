@@ -87,7 +87,6 @@ def prepare(arm, target, theta0, method, options, method_parameters, rows=None):
         task = task.weighted(options.weights)
     problem = Problem(task, arm, jnp.asarray(target[0] if rows else target))
     method = as_method(method, **method_parameters)
-    check_method_target(method, problem, name)
     L, n = problem.length_scale(), arm.n_joints
     method, options = method.resolved(L), options.resolved(L, n)
     if rows and np.ndim(theta0) == 2:
@@ -96,6 +95,7 @@ def prepare(arm, target, theta0, method, options, method_parameters, rows=None):
         theta0 = as_array(theta0, "theta0", shape=(n,))
     theta0 = np.clip(theta0, *options.joint_limits)
     method = with_priorities(method, problem, theta0.reshape(-1, n)[0], options)
+    check_method_target(method, problem, name)
     method = with_limits(method, options)
     return problem, method, options, theta0, target
 

@@ -33,7 +33,7 @@ class TrackResult:
 
     @property
     def jitter(self):
-        """ik.jitter of the joint path: the mean of sum_j |theta_j(t+1) - 2 theta_j(t) + theta_j(t-1)|."""
+        """ik.core.jitter.jitter of the joint path: the mean of sum_j |theta_j(t+1) - 2 theta_j(t) + theta_j(t-1)|."""
         return jitter(self.theta)
 
 

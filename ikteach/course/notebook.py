@@ -22,7 +22,7 @@ def setup(seed=SEED, pyvista=None, cpu_devices="cores", freeze_heap=True):
     pyvista="static" shows 3-D scenes as PNG images, "interactive" as pyvista's live trame
     view (needs the `3d` extra); None (default) reads $IKTEACH_PYVISTA, else picks live 3-D
     when trame is installed and a display is present. Headless, pyvista renders off screen.
-    pyvista itself loads only when a notebook first draws in 3-D (ik.scene).
+    pyvista itself loads only when a notebook first draws in 3-D (ik.pictures.scene).
     Compiled solvers are kept on disk between runs (see compilation_cache).
 
     Kernel-wide settings, each measured where the class waits for it and each with its off

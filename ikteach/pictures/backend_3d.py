@@ -1,6 +1,6 @@
 """Which pyvista backend shows 3-D scenes: static PNGs (headless, under test, committed
 notebooks) or pyvista's live trame view. Chosen by ik.notebook.setup(pyvista=...) or
-$IKTEACH_PYVISTA, and applied when ik.scene first loads pyvista (0.4 s saved where a notebook
+$IKTEACH_PYVISTA, and applied when ik.pictures.scene first loads pyvista (0.4 s saved where a notebook
 draws nothing in 3-D)."""
 import os
 import sys
@@ -27,7 +27,7 @@ _pyvista_choice = _NOT_CHOSEN  # what setup() asked for, until pyvista loads
 
 
 def choose_pyvista(choice=None):
-    """Check and keep the 3-D backend choice: set now if pyvista is loaded, else when ik.scene
+    """Check and keep the 3-D backend choice: set now if pyvista is loaded, else when ik.pictures.scene
     first loads it (importing pyvista costs about 0.4 s; most notebooks draw nothing in 3-D)."""
     global _pyvista_choice
     _pyvista_choice = _checked_choice(choice)
@@ -36,7 +36,7 @@ def choose_pyvista(choice=None):
 
 
 def apply_pyvista_choice():
-    """Set the backend setup() chose, once; called by ik.scene as it loads pyvista."""
+    """Set the backend setup() chose, once; called by ik.pictures.scene as it loads pyvista."""
     global _pyvista_choice
     if _pyvista_choice is _NOT_CHOSEN:
         return None

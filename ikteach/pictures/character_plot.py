@@ -62,7 +62,7 @@ def animate_clips(rig, clips, titles, root, view="side", every=3, interval=100, 
     grey crosses; close_up adds a row that looks at the feet from near the ground.
 
     The camera follows by moving the drawing, not the axes (x is measured from the root), so
-    the axes stay still and ik.plot.frame_pngs / save_gif draw them once."""
+    the axes stay still and ik.pictures.plot.frame_pngs / save_gif draw them once."""
     import matplotlib.pyplot as plt
 
     from .plot import _animation

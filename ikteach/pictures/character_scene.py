@@ -1,5 +1,5 @@
 """A character in 3-D with pyvista: bones as tubes, joints as balls, on a floor; shown through
-ik.scene.show (a static PNG off screen, pyvista's live view in a live Jupyter)."""
+ik.pictures.scene.show (a static PNG off screen, pyvista's live view in a live Jupyter)."""
 import numpy as np
 
 from .scene import WINDOW, _pv, add_meshes

@@ -1,6 +1,6 @@
 """The lab's interactive demo: drag the target, watch the arm follow.
 
-    demo = ik.demo.Demo()          # widgets: target x, y, lambda, method, preset buttons
+    demo = ik.pictures.demo.Demo()          # widgets: target x, y, lambda, method, preset buttons
     demo.widget                    # display it in a notebook
     demo.update(x=3.5, y=1.0)      # what a slider change does; returns the Result
 
@@ -31,9 +31,9 @@ from matplotlib.colors import to_hex
 from matplotlib.figure import Figure
 
 from . import plot
-from .stills import named_slider, png, still_html, with_still  # noqa: F401  (ik.demo.png)
+from .stills import named_slider, png, still_html, with_still  # noqa: F401  (ik.pictures.demo.png)
 from ..core.chain import planar_chain, reach
-from ..core.methods import named
+from ..core.methods import as_method
 from ..core.solve import solve
 
 PRESETS = {
@@ -256,7 +256,7 @@ class Demo:
             self._holding = False
         target = np.array([self.x.value, self.y.value])
         self.result = solve(self.arm, target, self.theta0,
-                            method=named(self.method.value, damping=self.damping.value), tol=self.tol, max_iter=self.max_iter,
+                            method=as_method(self.method.value, damping=self.damping.value), tol=self.tol, max_iter=self.max_iter,
                             clamp=self.clamp)
         self.summary = summary(self.method.value, self.result)
         self.alt = alt_text(self.arm, target, self.summary)  # the still's <img alt>

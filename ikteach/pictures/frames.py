@@ -1,7 +1,7 @@
 """Animations as pictures: lay a figure out once, draw its frames (only what moves is
 redrawn), encode them as PNGs, GIFs or a playable HTML animation, and show one in a notebook
-with its still frame and alt text. ik.plot re-exports these (ik.plot.show, ik.plot.save_gif,
-ik.plot.gif_view). Text in a frame is at least MIN_TEXT_PX pixels tall (smallest_text_px).
+with its still frame and alt text. ik.pictures.plot re-exports these (ik.pictures.plot.show, ik.pictures.plot.save_gif,
+ik.pictures.plot.gif_view). Text in a frame is at least MIN_TEXT_PX pixels tall (smallest_text_px).
 """
 import io
 

@@ -1,7 +1,7 @@
 """A live workspace map: a lambda slider and a method dropdown re-solve a grid of targets
 with ik.solve_batch and redraw the map (iterations, final error or status) as a PNG.
 
-    live = ik.live_map.LiveMap()      # widgets; live.widget to display in a notebook
+    live = ik.pictures.live_map.LiveMap()      # widgets; live.widget to display in a notebook
     live.update(damping=0.2)          # what a control change does; returns the SweepMap
     live.png, live.still()            # the current picture; as HTML with alt text (static viewers)
 
@@ -25,7 +25,7 @@ from concurrent.futures import Future, ThreadPoolExecutor
 import numpy as np
 
 from ..core.chain import planar_chain
-from ..core.methods import named
+from ..core.methods import as_method
 from ..core.sweeps import sweep, target_grid
 from .workspace_maps import status_image
 
@@ -64,8 +64,8 @@ def map_image(result, quantity):
 
 
 def compute_map(arm, grid, theta0, method="dls", damping=0.5, quantity="iterations", **kwargs):
-    """Solve every grid target (ik.workspace.sweep) and return (SweepMap, image)."""
-    result = sweep(arm, grid, theta0, method=named(method, damping=damping), **kwargs)
+    """Solve every grid target (ik.pictures.workspace_maps.sweep) and return (SweepMap, image)."""
+    result = sweep(arm, grid, theta0, method=as_method(method, damping=damping), **kwargs)
     return result, map_image(result, quantity)
 
 
@@ -159,7 +159,7 @@ class LiveMap:
         self._maps[key] = value
 
     def _sweep(self, method, damping):
-        return sweep(self.arm, self.grid, self.theta0, method=named(method, damping=damping),
+        return sweep(self.arm, self.grid, self.theta0, method=as_method(method, damping=damping),
                      tol=self.tol, max_iter=self.max_iter)
 
     def map_for(self, method, damping):

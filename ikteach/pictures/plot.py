@@ -4,15 +4,15 @@ Every helper draws on a matplotlib Axes you pass in (or builds its own small fig
 returns what it drew, so notebooks and exercises can combine them freely:
 
     fig, ax = plt.subplots()
-    ik.plot.arm_axes(ax, arm)                    # equal aspect, limits from the arm's reach
-    ik.plot.draw_arm(ax, arm, theta)             # links, joints, end effector
-    ik.plot.draw_target(ax, target)
-    ik.plot.draw_path(ax, arm, res.trace.theta)  # end-effector path over the iterations
-    ik.plot.draw_ellipse(ax, arm, theta)         # velocity (manipulability) ellipse
-    ik.plot.plot_errors(ax, {"dls": res})        # ||e|| per iteration, log scale
-    anim = ik.plot.animate_solve(arm, res, target)          # arm beside its error curve
-    anim = ik.plot.animate_race(arm, {"jt": r1, "dls": r2}, target)
-    ik.plot.show(anim)                           # still frame (PNG) + playable JS animation
+    ik.pictures.plot.arm_axes(ax, arm)                    # equal aspect, limits from the arm's reach
+    ik.pictures.plot.draw_arm(ax, arm, theta)             # links, joints, end effector
+    ik.pictures.plot.draw_target(ax, target)
+    ik.pictures.plot.draw_path(ax, arm, res.trace.theta)  # end-effector path over the iterations
+    ik.pictures.plot.draw_ellipse(ax, arm, theta)         # velocity (manipulability) ellipse
+    ik.pictures.plot.plot_errors(ax, {"dls": res})        # ||e|| per iteration, log scale
+    anim = ik.pictures.plot.animate_solve(arm, res, target)          # arm beside its error curve
+    anim = ik.pictures.plot.animate_race(arm, {"jt": r1, "dls": r2}, target)
+    ik.pictures.plot.show(anim)                           # still frame (PNG) + playable JS animation
 
 Planar arms are drawn in their plane; spatial chains are drawn projected on x-y.
 """
@@ -207,7 +207,7 @@ def animate_solve(arm, result, target, max_frames=MAX_FRAMES, title=None, spacin
                   figsize=(8.0, 3.4)):
     """The arm converging (left) beside its error curve (right), one frame per shown iteration.
 
-    Returns a matplotlib FuncAnimation (display it with ik.plot.show); anim.iterations lists
+    Returns a matplotlib FuncAnimation (display it with ik.pictures.plot.show); anim.iterations lists
     the iteration of each frame and anim.still is the last frame's index.
     """
     ks = frame_iterations(result.iterations, max_frames, spacing)

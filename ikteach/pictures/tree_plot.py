@@ -30,7 +30,7 @@ def draw_tree(ax, arm, theta, targets=None, plane=(0, 1), color="C0"):
 def animate_tree(arm, thetas, targets, plane=(0, 1), limits=((-2.5, 4.0), (-1.0, 2.5)), interval=50,
                  times=None, title="tree"):
     """A FuncAnimation of the tree following its targets (one frame per row of thetas), titled
-    with the time of each frame (`times`, s) when given; show it with ik.plot.show (still frame)."""
+    with the time of each frame (`times`, s) when given; show it with ik.pictures.plot.show (still frame)."""
     import matplotlib.pyplot as plt
 
     from .plot import _animation

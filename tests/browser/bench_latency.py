@@ -31,11 +31,11 @@ from labdriver import chromium, jupyterlab, kernel_states, run_all, wait_until  
 
 CELLS = [
     "import ikteach as ik\nrng = ik.notebook.setup()",
-    "demo = ik.demo.Demo()\ndemo.widget",
+    "demo = ik.pictures.demo.Demo()\ndemo.widget",
     "arm = ik.planar_chain([1.0, 0.5, 0.25])  # as notebook 07\n"
-    "live = ik.live_map.LiveMap(arm, grid_n=128, theta0=[0.3, 0.6, 0.6], damping=0.2, "
+    "live = ik.pictures.live_map.LiveMap(arm, grid_n=128, theta0=[0.3, 0.6, 0.6], damping=0.2, "
     "max_iter=100)\nlive.widget",
-    "cold = ik.live_map.LiveMap(arm, grid_n=128, theta0=[0.3, 0.6, 0.6], damping=0.2, "
+    "cold = ik.pictures.live_map.LiveMap(arm, grid_n=128, theta0=[0.3, 0.6, 0.6], damping=0.2, "
     "max_iter=100, prefetch=False)\ncold.widget  # every lambda solved when asked for",
 ]
 GOALS = {"demo x": 50, "map lambda": 150, "map no prefetch": None, "demo method": None,

@@ -75,7 +75,7 @@ def _demo(driver):
                             "the demo widget")[0]
     except AssertionError:
         cell = _js(driver, "return [...document.querySelectorAll('.jp-CodeCell')]"
-                           ".find(c => c.innerText.includes('ik.demo.Demo()'))")
+                           ".find(c => c.innerText.includes('ik.pictures.demo.Demo()'))")
         _js(driver, "arguments[0].scrollIntoView({block: 'start'})", cell)
         _shot(driver, "failed-demo")
         for error in cell.find_elements(By.CSS_SELECTOR, ".jupyter-widgets-error-widget"):
