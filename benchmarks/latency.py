@@ -23,7 +23,7 @@ IMPORT_S = time.perf_counter() - t_import
 from ikteach._runtime import devices  # noqa: E402
 
 CPU_DEVICES = devices.use_cores()  # as ik.notebook.setup() does in the course notebooks
-METHODS = ("jt", "pinv", "dls", "sdls", "ccd", "fabrik")
+METHODS = tuple(ik.core.methods.METHODS)
 THETA0 = np.array([0.1, 0.2, 0.3])
 
 

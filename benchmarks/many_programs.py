@@ -46,7 +46,7 @@ def main():
         lambda event, duration, **kw: compiles.append(duration)
         if event.endswith("backend_compile_duration") else None)
     rng = np.random.default_rng(0)
-    methods = ("jt", "pinv", "dls", "sdls", "ccd", "fabrik")
+    methods = tuple(ik.core.methods.METHODS)
     spatial = {n: ik.serial_chain(np.tile([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0]], (n, 1))[:n],
                                   [[0.0, 0.0, 0.3]] * n) for n in range(1, 13)}
     print(f"bound: {runtime_jit.max_programs() or 'none'} programs; "

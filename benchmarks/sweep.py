@@ -17,8 +17,8 @@ import numpy as np
 
 import ikteach as ik
 from ikteach._runtime import devices
-from ikteach.core import batch as batch_module
-from ikteach.core.solve import STALL_FRACTION
+from ikteach._runtime import engine as batch_module
+from ikteach.core.stop_rules import STALL_FRACTION
 
 import native  # benchmarks/native: the scalar C loop
 

@@ -71,7 +71,7 @@ def _small_then_queued(monkeypatch, solve):
         return small, solve(len(small))
 
 
-@pytest.mark.parametrize("method", ["jt", "pinv", "dls", "sdls", "ccd", "fabrik"])
+@pytest.mark.parametrize("method", list(ik.core.methods.METHODS))
 def test_a_small_batch_solves_one_by_one_as_the_queue_does(method, monkeypatch):
     targets = np.random.default_rng(3).uniform(-3.5, 3.5, size=(64, 2))
     _same(*_small_then_queued(monkeypatch, lambda k: ik.solve_batch(

@@ -10,7 +10,7 @@ from ikteach.core.solve import TRACE_CHUNK
 
 ARM = ik.planar_chain([1.0, 1.0, 1.0])
 START = np.array([0.1, 0.2, 0.3])
-METHODS = ("jt", "pinv", "dls", "sdls", "ccd", "fabrik")
+METHODS = tuple(ik.core.methods.METHODS)
 COMPILES = []
 
 

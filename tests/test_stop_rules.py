@@ -12,7 +12,7 @@ from ikteach.core import stop_rules
 solve_module = importlib.import_module("ikteach.core.solve")
 
 START = np.array([0.1, 0.2, 0.3])
-METHODS = ["jt", "pinv", "dls", "sdls", "ccd", "fabrik"]
+METHODS = list(ik.core.methods.METHODS)
 SCALES = [1e-3, 1e-2, 1.0, 1e2, 1e3]
 REACHABLE, UNREACHABLE = np.array([2.5, 0.5]), np.array([3.5, 1.0])
 

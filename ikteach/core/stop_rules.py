@@ -40,6 +40,7 @@ import numpy as np
 from .._runtime import jit as runtime_jit
 
 STOP_RULES = ("joint_steps", "motion")
+STALL_FRACTION = 1e-5  # the report's loop: stall_tol = STALL_FRACTION x L (benchmarks/sweep.py)
 DEFAULT_STOP_RULE = "motion"
 SLOW_PROGRESS = 1e-4  # "slow" when ||e|| still fell by more than this fraction in the last step
 GRADIENT_FRACTION = 1e-2  # stationary: ||J^T e|| below this fraction of sigma_max ||e||
