@@ -6,7 +6,8 @@ matplotlib.use("Agg")
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from ikteach import bvh, character_plot, character_scene, clip_ik, look_at, scene, skeleton  # noqa: E402
+from ikteach.characters import bvh, clip_ik, look_at, skeleton
+from ikteach.pictures import character_plot, character_scene, scene  # noqa: E402
 
 REACH = ["LeftFoot", "RightFoot", "LeftFoot_end", "RightFoot_end", "RightHand_end"]
 MAY_TURN = {"Hips": ["Xrotation"], "Spine": ["Xrotation"], "Chest": ["Xrotation", "Yrotation"],

@@ -6,7 +6,7 @@ from jax import monitoring
 
 import ikteach as ik
 from ikteach.core.kinematics import end_path
-from ikteach.core.solve import TRACE_CHUNK
+from ikteach._runtime.engine import TRACE_CHUNK
 
 ARM = ik.planar_chain([1.0, 1.0, 1.0])
 START = np.array([0.1, 0.2, 0.3])
@@ -78,7 +78,7 @@ def test_eager_solves_with_a_python_step_compile_nothing_new(stop_rule):
 def test_paths_of_any_length_track_with_one_program():
     """track runs paths CHUNK steps at a time: a new length compiles nothing, and a path's
     first steps are the same whatever follows them (across chunk boundaries too)."""
-    from ikteach.core.track import CHUNK
+    from ikteach._runtime.engine import SCAN_CHUNK as CHUNK
 
     path = np.stack([np.linspace(1.0, 2.8, 2 * CHUNK + 9), np.linspace(0.5, 1.2, 2 * CHUNK + 9)], 1)
     whole = ik.track(ARM, path, START, method="dls", damping=0.2)

@@ -12,7 +12,7 @@ import pytest  # noqa: E402
 import ikteach as ik  # noqa: E402
 
 pytest.importorskip("ipywidgets")
-from ikteach import demo as ikdemo  # noqa: E402
+from ikteach.pictures import demo as ikdemo  # noqa: E402
 
 ARM = ik.planar_chain([1.0, 1.0, 1.0])
 START = np.array([0.1, 0.2, 0.3])

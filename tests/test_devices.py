@@ -11,7 +11,7 @@ from ikteach._runtime import devices
 
 SPLIT_CHECK = textwrap.dedent("""
     import numpy as np, jax, ikteach as ik
-    from ikteach.core import batch
+    from ikteach._runtime import engine as batch
     ik.notebook.setup(cpu_devices=3)
     ik.notebook.compilation_cache()  # the tests' folder ($IKTEACH_JAX_CACHE), as in conftest
     assert len(jax.devices()) == 3, jax.devices()

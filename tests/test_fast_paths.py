@@ -1,49 +1,28 @@
-"""The solver's specialised arithmetic equals the general path it replaces: the closed-form
-small solve of DLS, the two-row pseudoinverse, e and J from one walk of the chain, and refilling slots every few steps."""
+"""The solver's specialised arithmetic equals the general path it replaces: the two-row
+pseudoinverse (taught in lecture 03), e and J from one walk of the chain, and refilling slots
+every few steps."""
 import jax
 import numpy as np
 import pytest
 
 import ikteach as ik
-from ikteach.core import batch
-from ikteach.core.small_solve import solve_small
-from ikteach.core.solve import linearize
+from ikteach._runtime import engine as batch
+from ikteach.core.problem import Problem
 from ikteach.core.tasks import PositionTask
 
 RNG = np.random.default_rng(11)
 
 
-@pytest.mark.parametrize("m", [1, 2, 3, 4, 6])
-def test_solve_small_equals_lu(m):
-    for _ in range(10):
-        J = RNG.normal(size=(m, 7))
-        A = J @ J.T + 0.1 * np.eye(m)
-        b = RNG.normal(size=m)
-        np.testing.assert_allclose(solve_small(A, b), np.linalg.solve(A, b), rtol=1e-10,
-                                   atol=1e-12)
-
-
-def test_solve_small_of_a_singular_matrix_is_not_finite():
-    """With lambda = 0 at a singular pose DLS must fail loudly (the loop then says diverged)."""
-    x = solve_small(np.zeros((2, 2)), np.ones(2))
-    assert not np.all(np.isfinite(x))
-
-
 def test_dls_step_equals_the_normal_equations():
-    for lengths in ([1.0, 1.0, 1.0], [0.5, 1.2, 0.3, 0.9]):  # m = 2: the 2 x 2 closed form
+    for lengths in ([1.0, 1.0, 1.0], [0.5, 1.2, 0.3, 0.9]):  # m = 2
         arm = ik.planar_chain(lengths)
         J = ik.jacobian(arm, RNG.normal(size=len(lengths)))
         e = RNG.normal(size=2)
         np.testing.assert_allclose(ik.dls_step(J, e, 0.5), ik.dls_step_normal(J, e, 0.5),
                                    atol=1e-12)
-    J = np.asarray(ik.jacobian(ik.core.robots.ur5(), RNG.normal(size=6)))  # m = 3: the adjugate
+    J = np.asarray(ik.jacobian(ik.core.robots.ur5(), RNG.normal(size=6)))  # m = 3
     e = RNG.normal(size=3)
     np.testing.assert_allclose(ik.dls_step(J, e, 0.3), ik.dls_step_normal(J, e, 0.3), atol=1e-12)
-
-
-def one_walk(task, arm, target, theta):
-    e, linearized = linearize(task, arm, target, theta)
-    return e, linearized.jacobian(arm, theta)
 
 
 @pytest.mark.parametrize("arm", [ik.planar_chain([1.0, 0.7, 0.4], base=(0.2, -0.1)), ik.core.robots.ur5()],
@@ -53,17 +32,9 @@ def test_one_walk_of_the_chain_gives_the_same_e_and_J_as_two(arm):
     for _ in range(5):
         theta = RNG.normal(scale=2.0, size=arm.n_joints)
         target = RNG.normal(size=arm.dim)
-        e, J = jax.jit(lambda q: one_walk(task, arm, target, q))(theta)
+        e, J = jax.jit(lambda q: Problem(task, arm, target).error_and_jacobian(q))(theta)
         np.testing.assert_allclose(e, task.error(arm, target, theta), rtol=0, atol=1e-13)
         np.testing.assert_allclose(J, task.jacobian(arm, theta), rtol=0, atol=1e-13)
-
-
-def test_the_linearized_task_computes_J_afresh_at_another_theta():
-    arm, task = ik.planar_chain([1.0, 1.0]), PositionTask()
-    theta, other = np.array([0.3, 0.4]), np.array([1.0, -0.5])
-    _, linearized = linearize(task, arm, np.array([1.0, 1.0]), theta)
-    np.testing.assert_array_equal(linearized.jacobian(arm, other), ik.jacobian(arm, other))
-    assert linearized.length_scale(arm) == task.length_scale(arm)  # the rest is the task's
 
 
 @pytest.mark.parametrize("steps", [1, 3])

@@ -8,7 +8,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 import ikteach as ik  # noqa: E402
-from ikteach import plot  # noqa: E402
+from ikteach.pictures import plot  # noqa: E402
 
 ARM = ik.planar_chain([1.0, 1.0, 1.0])
 START = np.array([0.1, 0.2, 0.3])

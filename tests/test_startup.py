@@ -18,10 +18,13 @@ def test_import_loads_no_heavy_library():
 
 
 def test_lazy_modules_work_as_attributes():
-    code = ("import sys, ikteach as ik; ik.pictures.workspace_maps.target_grid; ik.pictures.plot.draw_arm; "
-            "ik.pictures.demo.Demo; ik.pictures.scene.scene; ik.check; from ikteach import tree_plot; "
-            "print('matplotlib' in sys.modules, sorted(set(ik.LAZY) - set(dir(ik))))")
-    assert _run(code) == ["True", "[]"]
+    code = ("import sys, ikteach as ik; print('matplotlib' in sys.modules); "
+            "ik.pictures.workspace_maps.target_grid; ik.pictures.plot.draw_arm; "
+            "ik.pictures.demo.Demo; ik.pictures.scene.scene; ik.check.jacobian; "
+            "from ikteach.pictures import tree_plot; ik.core.settle.settle_factor; "
+            "print('matplotlib' in sys.modules, len(ik.__all__) <= 40, "
+            "all(hasattr(ik, name) for name in ik.__all__))")
+    assert _run(code) == ["False", "True", "True", "True"]
 
 
 def test_an_unknown_attribute_is_an_attribute_error():

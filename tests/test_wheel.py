@@ -50,7 +50,7 @@ assert res.status == "converged", res.status
 print("solve:", res.status, res.iterations)
 
 import jax
-from ikteach.core import batch
+from ikteach._runtime import engine as batch
 grid = np.stack(np.meshgrid(np.linspace(-3.2, 3.2, 20), np.linspace(-3.2, 3.2, 20)), -1).reshape(-1, 2)
 batch.SPLIT_FROM = 16  # split even this small grid over the devices, then compare with one
 split = ik.solve_batch(arm, grid, np.full(3, 0.3))

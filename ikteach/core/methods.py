@@ -26,12 +26,21 @@ class StepFunction(JacobianMethod):
     def step(self, J, e):
         return check_step(self.fn(J, e))
 
+    def delta(self, problem, theta, e, J, free=None):
+        delta = self.step(J, e)
+        if delta.shape != theta.shape:
+            raise ValueError(f"method: the step function returned shape {delta.shape}, "
+                             f"expected {theta.shape} (one entry per joint)")
+        return delta.astype(theta.dtype)
+
 
 def check_step(delta):
     """A step function's output as an array of real numbers, or a ValueError naming `method`."""
     what = "method: the step function must return an array delta_theta (one real number per joint)"
-    if delta is None or isinstance(delta, (str, bytes, dict)):
-        raise ValueError(f"{what}, got {type(delta).__name__} {delta!r:.80}")
+    if delta is None or isinstance(delta, (str, bytes)):
+        raise ValueError(f"{what}, got {delta!r:.80}")
+    if isinstance(delta, dict):
+        raise ValueError(f"{what}, got a dict {delta!r:.80}")
     try:
         delta = jnp.asarray(delta)
     except TypeError:

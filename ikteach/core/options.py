@@ -108,7 +108,11 @@ def check_limits(joint_limits):
                          f"got {joint_limits!r:.80}") from None
     out = []
     for name, bound, bad in (("lower", lower, np.inf), ("upper", upper, -np.inf)):
-        arr = numeric(bound, "joint_limits")
+        try:
+            arr = numeric(bound, "joint_limits")
+        except ValueError:
+            raise ValueError(f"joint_limits: expected {name} as a number or one per joint, "
+                             f"got {bound!r:.80}") from None
         if arr.ndim > 1:
             raise ValueError(f"joint_limits: expected {name} as a number or one per joint, "
                              f"got shape {arr.shape}")

@@ -74,9 +74,10 @@ def prepare(arm, target, theta0, method, options, method_parameters, rows=None):
     target holds one target per row; the problem then holds the first."""
     name = rows or "target"
     target = as_array(target, name)
-    if rows and (target.ndim < 2 or target.shape[0] == 0):
-        raise ValueError(f"{name}: expected one target per row (at least one), got shape "
-                         f"{target.shape}")
+    if rows and target.ndim < 2:
+        raise ValueError(f"{name}: expected one target per row, got shape {target.shape}")
+    if rows and target.shape[0] == 0:
+        raise ValueError(f"{name}: expected at least one target, got none (shape {target.shape})")
     task = task_for(arm, target.shape[1:] if rows else target.shape, name)
     if hasattr(task, "check_target"):  # pose targets: rigid transforms only
         task.check_target(target, name)

@@ -13,7 +13,6 @@ from .jacobian import jacobian
 from ._validate import as_array
 from .kinematics import end_path  # noqa: F401  (ws.end_path, used by the notebook)
 from .jitter import jitter_per_step
-from .methods import as_method
 from .solve import status_counts
 from .track import track as follow
 
@@ -123,6 +122,6 @@ def track(arm, path, theta0, method="dls", damping=0.5, rcond=1e-6, clamp=None, 
     """Buss's moving-target protocol along a path (k, d): one step of `method` per frame,
     from the previous theta (ik.track), kept with per-frame jitter for the maps notebook."""
     theta0 = as_array(theta0, "theta0", shape=(arm.n_joints,))
-    res = follow(arm, path, theta0, method=as_method(method, damping=damping, rcond=rcond),
-                 clamp=clamp, max_step=max_step)
+    res = follow(arm, path, theta0, method=method, damping=damping, rcond=rcond, clamp=clamp,
+                 max_step=max_step)
     return Tracking(_method_name(method), res.theta[1:], res.error)

@@ -80,9 +80,11 @@ def track(arm, targets, theta0=None, method="dls", options=None, *, damping=None
     if clamp_growth and options.clamp is None:
         raise ValueError("clamp_growth: grows the clamp D_max; give clamp= too")
     targets = as_array(targets, "targets")
-    if targets.ndim < 2 or targets.shape[0] == 0:
-        raise ValueError(f"targets: expected one target per time step (at least one), got "
-                         f"shape {targets.shape}")
+    if targets.ndim < 2:
+        raise ValueError(f"targets: expected one target per time step, got shape {targets.shape}")
+    if targets.shape[0] == 0:
+        raise ValueError(f"targets: expected at least one time step, got none (shape "
+                         f"{targets.shape})")
     theta0 = np.zeros(arm.n_joints) if theta0 is None else as_array(theta0, "theta0",
                                                                     shape=(arm.n_joints,))
     problem, method, options, theta0, targets = prepare(

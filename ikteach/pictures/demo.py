@@ -33,7 +33,6 @@ from matplotlib.figure import Figure
 from . import plot
 from .stills import named_slider, png, still_html, with_still  # noqa: F401  (ik.pictures.demo.png)
 from ..core.chain import planar_chain, reach
-from ..core.methods import as_method
 from ..core.solve import solve
 
 PRESETS = {
@@ -256,7 +255,8 @@ class Demo:
             self._holding = False
         target = np.array([self.x.value, self.y.value])
         self.result = solve(self.arm, target, self.theta0,
-                            method=as_method(self.method.value, damping=self.damping.value), tol=self.tol, max_iter=self.max_iter,
+                            method=self.method.value, damping=self.damping.value,
+                            tol=self.tol, max_iter=self.max_iter,
                             clamp=self.clamp)
         self.summary = summary(self.method.value, self.result)
         self.alt = alt_text(self.arm, target, self.summary)  # the still's <img alt>

@@ -25,7 +25,6 @@ from concurrent.futures import Future, ThreadPoolExecutor
 import numpy as np
 
 from ..core.chain import planar_chain
-from ..core.methods import as_method
 from ..core.sweeps import sweep, target_grid
 from .workspace_maps import status_image
 
@@ -65,7 +64,7 @@ def map_image(result, quantity):
 
 def compute_map(arm, grid, theta0, method="dls", damping=0.5, quantity="iterations", **kwargs):
     """Solve every grid target (ik.pictures.workspace_maps.sweep) and return (SweepMap, image)."""
-    result = sweep(arm, grid, theta0, method=as_method(method, damping=damping), **kwargs)
+    result = sweep(arm, grid, theta0, method=method, damping=damping, **kwargs)
     return result, map_image(result, quantity)
 
 
@@ -159,7 +158,7 @@ class LiveMap:
         self._maps[key] = value
 
     def _sweep(self, method, damping):
-        return sweep(self.arm, self.grid, self.theta0, method=as_method(method, damping=damping),
+        return sweep(self.arm, self.grid, self.theta0, method=method, damping=damping,
                      tol=self.tol, max_iter=self.max_iter)
 
     def map_for(self, method, damping):
