@@ -121,7 +121,7 @@ def check_limits(joint_limits):
                              f"got {arr.tolist()}")
         out.append(arr)
     try:
-        lower, upper = np.broadcast_arrays(*out)
+        lower, upper = np.broadcast_arrays(*map(np.atleast_1d, out))
     except ValueError:
         raise ValueError(f"joint_limits: expected lower and upper of the same length, got "
                          f"shapes {out[0].shape} and {out[1].shape}") from None
