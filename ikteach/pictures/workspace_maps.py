@@ -7,8 +7,18 @@ import numpy as np
 from ..core.workspace import (Grid, SweepMap, Tracking, end_path, reach_radii, sigma_min,  # noqa: F401
                               sweep, target_grid, track)
 
+# one colour per status of ik.STATUSES (a status without one would be drawn white, like no target)
 STATUS_COLORS = {"converged": "#55a868", "stalled": "#dd8452", "max_iter": "#c44e52",
-                 "diverged": "#222222", "slow": "#8172b3"}
+                 "diverged": "#222222", "slow": "#8172b3", "singular": "#4c72b0", "damped": "#937860"}
+STATUS_COLOR_NAMES = {"converged": "green", "stalled": "orange", "max_iter": "red",
+                      "diverged": "black", "slow": "purple", "singular": "blue", "damped": "brown"}
+
+
+def status_legend(ax, **kwargs):
+    """A legend of every status colour (patches), drawn on ax; kwargs go to ax.legend."""
+    from matplotlib.patches import Patch
+
+    return ax.legend(handles=[Patch(color=c, label=s) for s, c in STATUS_COLORS.items()], **kwargs)
 
 
 def boundary(mask, grid):
