@@ -117,7 +117,11 @@ def test_a_character_scene_has_alt_text_naming_the_target_and_the_point_beside_i
     target = points[hand[0]] + [0.0, 0.0, 0.5]
     alt = character_scene.character_scene(rig, points, targets=target)._ikteach_alt
     assert alt.startswith("3-D view") and f"{len(points)} points" in alt
-    assert "purple target ball" in alt and "0.5 units from the RightHand" in alt
+    assert "purple target ball" in alt and "on the RightHand (reached)" in alt
+    away = character_scene.describe(rig, points, points[hand[0]] + [0.0, 0.0, 40.0])
+    k = int(np.argmin(np.linalg.norm(points - (points[hand[0]] + [0.0, 0.0, 40.0]), axis=1)))
+    gap = np.linalg.norm(points[k] - points[hand[0]] - [0.0, 0.0, 40.0])
+    assert f"{gap:.1f} units from the nearest point" in away and "reached" not in away
     assert "target" not in character_scene.describe(rig, points)
 
 

@@ -50,12 +50,13 @@ def describe(rig, points, targets=None):
     (next to which named point of the skeleton, and how far from it)."""
     points = np.asarray(points, dtype=float)
     height = np.ptp(points[:, 1])
-    words = [f"3-D view, from the front left, of a skeleton of {len(points)} points standing on a grey "
-             f"floor, {height:.0f} units tall: bones as tubes (left limbs blue, right limbs orange, "
-             "the spine and head grey), joints as dark balls"]
+    words = [f"3-D view, from the front left, of a skeleton of {len(points)} points on a grey floor, "
+             f"{height:.0f} units tall (the clip's units): bones as tubes (left limbs blue, right limbs "
+             "orange, the spine and head grey), joints as dark balls"]
     for t in [] if targets is None else np.asarray(targets, dtype=float).reshape(-1, 3):
         k = int(np.argmin(np.linalg.norm(points - t, axis=1)))
         gap = float(np.linalg.norm(points[k] - t))
-        words.append(f"a translucent purple target ball at ({t[0]:.0f}, {t[1]:.0f}, {t[2]:.0f}), "
-                     f"{gap:.1f} units from the {_point_name(rig, k)}")
+        where = (f"on the {_point_name(rig, k)} (reached)" if gap < 0.03 * height  # inside the ball
+                 else f"{gap:.1f} units from the nearest point, the {_point_name(rig, k)}")
+        words.append(f"a translucent purple target ball at ({t[0]:.0f}, {t[1]:.0f}, {t[2]:.0f}), {where}")
     return "; ".join(words) + "."
