@@ -14,13 +14,6 @@ STATUS_COLOR_NAMES = {"converged": "green", "stalled": "orange", "max_iter": "re
                       "diverged": "black", "slow": "purple", "singular": "blue", "damped": "brown"}
 
 
-def status_legend(ax, **kwargs):
-    """A legend of every status colour (patches), drawn on ax; kwargs go to ax.legend."""
-    from matplotlib.patches import Patch
-
-    return ax.legend(handles=[Patch(color=c, label=s) for s, c in STATUS_COLORS.items()], **kwargs)
-
-
 def boundary(mask, grid):
     """The boundary of a boolean image (True = reached), by skimage.measure.find_contours at
     level 0.5, as a list of (k, 2) arrays of workspace (x, y) points."""
