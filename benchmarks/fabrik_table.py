@@ -1,6 +1,9 @@
 """A 10-joint planar chain (links of length 1), 20 random reachable and 20 random unreachable
-targets: iterations and time per solve for each method, in the form of Table 1 of Aristidou &
-Lasenby, "FABRIK: a fast, iterative solver for the inverse kinematics problem" (2011).
+targets: iterations and time per solve for each method.
+
+The same kind of comparison as Aristidou & Lasenby's, "FABRIK: a fast, iterative solver for the
+inverse kinematics problem" (2011), but not a reproduction of their table: their chains, targets,
+tolerance and implementations differ, and no number of theirs is quoted or compared here.
 
     python benchmarks/fabrik_table.py [--runs 20] [--tol 0.01]
 """

@@ -110,6 +110,22 @@ def test_character_scene_renders_off_screen(clip):
     assert (image < 200).mean() > 0.01                            # something dark was drawn on white
 
 
+def test_a_character_scene_has_alt_text_naming_the_target_and_the_point_beside_it(clip):
+    sk, _, root, theta = clip
+    rig = skeleton.rig(sk)
+    points = skeleton.world_points(rig, root, theta)[0]
+    hand = [k for k, name in enumerate(rig.points) if (name if isinstance(name, str) else name[0]) == "RightHand"]
+    target = points[hand[0]] + [0.0, 0.0, 0.5]
+    alt = character_scene.character_scene(rig, points, targets=target)._ikteach_alt
+    assert alt.startswith("3-D view") and f"{len(points)} points" in alt
+    assert "purple target ball" in alt and "on the RightHand (reached)" in alt
+    away = character_scene.describe(rig, points, points[hand[0]] + [0.0, 0.0, 40.0])
+    k = int(np.argmin(np.linalg.norm(points - (points[hand[0]] + [0.0, 0.0, 40.0]), axis=1)))
+    gap = np.linalg.norm(points[k] - points[hand[0]] - [0.0, 0.0, 40.0])
+    assert f"{gap:.1f} units from the nearest point" in away and "reached" not in away
+    assert "target" not in character_scene.describe(rig, points)
+
+
 def test_bad_input_names_the_parameter(clip):
     sk, rig, root, theta = clip
     with pytest.raises(ValueError, match="^point: expected shape"):

@@ -29,6 +29,27 @@ def test_error_and_status_pictures():
     assert not np.any(np.all(rgb[far] == np.array([0x55, 0xA8, 0x68]) / 255, axis=-1))
 
 
+def test_every_status_has_its_own_colour_and_a_word_in_the_live_legend():
+    finished = ik.STATUSES[1:]  # every status a solve can end with ("running" never does)
+    assert ik.STATUSES[0] == "running"
+    assert set(ws.STATUS_COLORS) == set(ws.STATUS_COLOR_NAMES) == set(finished)
+    assert len(set(ws.STATUS_COLORS.values())) == len(finished)  # none drawn like another
+    status = np.array([finished, finished])
+    rgb = ws.status_image(status)
+    assert not np.any(np.all(rgb == 1.0, axis=-1))  # white only where no target is
+    legend = " ".join(live_map._label("status", 100).split())
+    assert all(f"{ws.STATUS_COLOR_NAMES[s]} {s}" in legend for s in finished)
+
+
+def test_the_live_map_counts_are_the_batch_solves_at_the_default_tol():
+    arm = ik.planar_chain([1.0, 0.5, 0.25])  # L/3000 = 5.8e-4, not 1e-3
+    live = live_map.LiveMap(arm, grid_n=12, max_iter=50, damping=0.2, prefetch=False)
+    batch = ik.solve_batch(arm, live.grid.points, live.theta0, method="dls", damping=0.2, max_iter=50)
+    assert live.result.counts() == batch.counts()
+    assert live.result.counts() != ik.solve_batch(arm, live.grid.points, live.theta0, method="dls",
+                                                  damping=0.2, max_iter=50, tol=1e-3).counts()
+
+
 def test_an_unknown_quantity_is_a_value_error():
     with pytest.raises(ValueError, match="quantity"):
         live_map.compute_map(ARM, GRID, START, quantity="speed", max_iter=5)
@@ -91,7 +112,7 @@ def test_the_maps_one_step_either_side_are_prefetched_and_a_step_solves_nothing(
     assert calls == [("dls", 0.5), ("dls", 0.55), ("dls", 0.6)]
     live.damping.value = 0.6  # one step: solved already
     assert calls.count(("dls", 0.6)) == 1
-    ref = real(ARM, live.grid, live.theta0, method="dls", damping=0.6, tol=1e-3, max_iter=50)
+    ref = real(ARM, live.grid, live.theta0, method="dls", damping=0.6, max_iter=50)
     np.testing.assert_array_equal(live.result.iterations, ref.iterations)
     live.method.value = "jt"  # lambda unused: nothing prefetched
     live.damping.value = 1.0

@@ -254,6 +254,18 @@ def test_every_img_and_gif_says_what_it_shows(path):
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.relative_to(ROOT).as_posix())
+def test_no_output_loads_anything_from_the_network(path):
+    """Committed outputs open offline (a lecture hall, a book from disk): no stylesheet, script
+    or image from a URL, e.g. the font-awesome CDN of matplotlib's animation player."""
+    for i, cell in enumerate(_load(path)["cells"]):
+        for output in cell.get("outputs", []):
+            page = "".join(output.get("data", {}).get("text/html", []))
+            outside = re.findall(r"""(?:src|href)\s*=\s*["']?((?:https?:)?//[^"'\s>]+)""", page)
+            assert not outside, f"{path.name} cell {i}: output loads {outside[:2]} from the network"
+            assert not re.search(r'class="fa\b', page), f"{path.name} cell {i}: a font-awesome icon"
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.relative_to(ROOT).as_posix())
 def test_a_widget_shows_a_still_where_no_kernel_runs_it(path):
     """A displayed widget's output carries an image (with alt text): never a bare 'VBox(...)'."""
     for i, cell in enumerate(_load(path)["cells"]):

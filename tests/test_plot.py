@@ -221,6 +221,8 @@ def html_alt(anim):
 
 
 def test_to_html_embeds_the_blitted_frames_and_plays_like_to_jshtml():
+    from ikteach.pictures import frames
+
     anim = _animation("solve")
     html = plot.to_html(anim, default_mode="once")
     reference = anim.to_jshtml(default_mode="once")
@@ -230,8 +232,32 @@ def test_to_html_embeds_the_blitted_frames_and_plays_like_to_jshtml():
     def page(h):  # the HTML and script around the frames, ids made equal
         return re.sub(r"[0-9a-f]{32}", "ID", re.sub(r"data:image/png;base64,[A-Za-z0-9+/=\\\n]+", "PNG", h))
 
-    assert page(html) == page(reference.replace("<img id=", f'<img alt="{html_alt(anim)}" id=', 1))
+    with_alt = reference.replace("<img id=", f'<img alt="{html_alt(anim)}" id=', 1)
+    assert page(html) == page(frames.offline(with_alt))
     assert plot.embed_size(anim) == len(html.encode())
+
+
+@pytest.mark.parametrize("kind", ["solve", "other"])
+def test_animation_html_plays_offline_no_cdn_and_every_button_has_an_icon(kind):
+    """matplotlib's player loads font-awesome from a CDN: offline its buttons would be blank."""
+    import re
+
+    anim = _animation("solve")
+    if kind == "other":
+        del anim.draw_frame  # an animation not made here: the to_jshtml path
+    page = plot.to_html(anim)
+    assert "https://maxcdn" in anim.to_jshtml()  # what matplotlib's own page needs
+    assert not re.search(r"https?://|//cdn|font-awesome|<link\b", page)
+    buttons = re.findall(r"<button\b.*?</button>", page, re.S)
+    assert len(buttons) == 9 and all(b.count("<svg") == 1 and "<i " not in b for b in buttons)
+    assert all(re.search(r'aria-label="[A-Z][a-z ]+"', b) for b in buttons)
+
+
+def test_offline_refuses_a_page_with_an_icon_it_does_not_know():
+    from ikteach.pictures import frames
+
+    with pytest.raises(ValueError, match="page"):
+        frames.offline('<button><i class="fa fa-rocket"></i></button>')
 
 
 @pytest.mark.parametrize("kind", ["solve", "race", "tree", "clips"])

@@ -134,6 +134,24 @@ def test_static_backend_displays_a_png_with_alt_text(backend, monkeypatch):
     assert 'src="data:image/png;base64,iVBORw0KGgo' in image.data
     alt = image.data.split('alt="')[1].split('"')[0]
     assert "3-joint arm" in alt and "target at (2.00, 1.00, 0.00)" in alt
+    tip = np.asarray(ik.fk(ik.planar_chain([1.0, 1.0, 1.0]), np.array([0.3, 0.2, 0.1])))
+    assert f"{np.linalg.norm(tip - [2.0, 1.0]):.2f} from the end effector" in alt
+
+
+def test_the_alt_text_says_what_a_reached_target_and_a_trail_look_like():
+    """A reached target sits inside the end effector's frame: the alt text must not promise a
+    visible purple target; the trail is named with its start and length."""
+    arm = ik.core.robots.ur5()
+    start = np.array([0.3, -1.2, 1.4, -0.6, -1.2, 0.4])
+    target = np.asarray(ik.fk_pose(arm, start + 0.3))
+    res = ik.solve(arm, target, start, method="dls", tol=1e-6, damping=0.01)
+    trail = np.asarray(ik.pictures.workspace_maps.end_path(arm, res.trace.theta))
+    alt = scene.describe(arm, res.theta, target=target, trail=trail, ghost=start)
+    assert "at the end effector, hidden by its frame (reached)" in alt
+    length = np.linalg.norm(np.diff(trail, axis=0), axis=1).sum()
+    assert f"thin red tube {length:.2f} long" in alt and f"({trail[0, 0]:.2f}, " in alt
+    away = scene.describe(arm, start, target=target)
+    assert "hidden" not in away and "from the end effector" in away
 
 
 def test_interactive_backend_hands_the_plotter_to_pyvista_even_off_screen(backend, monkeypatch):

@@ -36,4 +36,27 @@ def character_scene(rig, points, targets=None, window_size=WINDOW, plotter=None)
     eye = centre + height * np.array([1.3, 0.35, 1.9])
     p.camera_position = [tuple(eye), tuple(centre), tuple(UP)]
     p.camera.view_angle = 30.0
+    p._ikteach_alt = describe(rig, points, targets)  # ik.pictures.scene.show's alt text
     return p
+
+
+def _point_name(rig, k):
+    name = rig.points[k]
+    return name if isinstance(name, str) else name[0]
+
+
+def describe(rig, points, targets=None):
+    """Alt text for a character scene: what is drawn, how tall, and where each target is
+    (next to which named point of the skeleton, and how far from it)."""
+    points = np.asarray(points, dtype=float)
+    height = np.ptp(points[:, 1])
+    words = [f"3-D view, from the front left, of a skeleton of {len(points)} points on a grey floor, "
+             f"{height:.0f} units tall (the clip's units): bones as tubes (left limbs blue, right limbs "
+             "orange, the spine and head grey), joints as dark balls"]
+    for t in [] if targets is None else np.asarray(targets, dtype=float).reshape(-1, 3):
+        k = int(np.argmin(np.linalg.norm(points - t, axis=1)))
+        gap = float(np.linalg.norm(points[k] - t))
+        where = (f"on the {_point_name(rig, k)} (reached)" if gap < 0.03 * height  # inside the ball
+                 else f"{gap:.1f} units from the nearest point, the {_point_name(rig, k)}")
+        words.append(f"a translucent purple target ball at ({t[0]:.0f}, {t[1]:.0f}, {t[2]:.0f}), {where}")
+    return "; ".join(words) + "."

@@ -4,6 +4,7 @@ with its still frame and alt text. ik.pictures.plot re-exports these (ik.picture
 ik.pictures.plot.gif_view). Text in a frame is at least MIN_TEXT_PX pixels tall (smallest_text_px).
 """
 import io
+import re
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -153,12 +154,47 @@ def _with_alt(page, alt):
     return page.replace("<img id=", f'<img alt="{html.escape(alt, quote=True)}" id=', 1)
 
 
+# matplotlib's player draws its buttons with font-awesome icons from a CDN stylesheet: offline
+# (a lecture hall, a book opened from disk) the buttons are blank. Each icon becomes an inline
+# SVG (16 x 16, drawn in the text colour); the buttons keep their title and aria-label.
+_ICON_PATHS = {
+    "fa fa-minus": "M2 7h12v2H2z",
+    "fa fa-plus": "M7 2h2v5h5v2H9v5H7V9H2V7h5z",
+    "fa fa-play": "M4 2l10 6-10 6z",
+    "fa fa-play fa-flip-horizontal": "M12 2L2 8l10 6z",
+    "fa fa-pause": "M3 2h4v12H3zM9 2h4v12H9z",
+    "fa fa-step-forward": "M3 2l8 6-8 6zM11 2h2v12h-2z",
+    "fa fa-step-backward": "M13 2L5 8l8 6zM3 2h2v12H3z",
+    "fa fa-fast-forward": "M1 2l6 6-6 6zM7 2l6 6-6 6zM13 2h2v12h-2z",
+    "fa fa-fast-backward": "M15 2L9 8l6 6zM9 2L3 8l6 6zM1 2h2v12H1z",
+}
+_CDN_STYLESHEET = re.compile(r'<link rel="stylesheet"\s+href="https?://[^"]*font-awesome[^"]*">\s*')
+
+
+def _icon_svg(path):
+    return ('<svg width="14" height="14" viewBox="0 0 16 16" aria-hidden="true" focusable="false" '
+            f'style="vertical-align:middle"><path fill="currentColor" d="{path}"/></svg>')
+
+
+def offline(page):
+    """matplotlib's animation HTML without its font-awesome stylesheet from a CDN: every
+    button icon an inline SVG, so the page plays with its buttons drawn with no network.
+    An icon or an outside URL this does not know is a ValueError (a new matplotlib's player)."""
+    page = _CDN_STYLESHEET.sub("", page)
+    for name, path in _ICON_PATHS.items():
+        page = page.replace(f'<i class="{name}"></i>', _icon_svg(path))
+    left = re.findall(r'<i class="fa[^"]*"></i>|https?://[^\s"\'<>]+', page)
+    if left:
+        raise ValueError(f"page: animation HTML still needs {sorted(set(left))[:3]} (update _ICON_PATHS)")
+    return page
+
+
 def to_html(anim, default_mode="loop"):
     """The animation as playable JavaScript HTML, like anim.to_jshtml() but with frames from
-    frame_pngs (each frame draws only what moves) and alt text on its <img>; other
-    animations use to_jshtml."""
+    frame_pngs (each frame draws only what moves), alt text on its <img> and no outside URL
+    (offline: the buttons' icons inline); other animations use to_jshtml, made offline alike."""
     if not hasattr(anim, "draw_frame"):
-        return _with_alt(anim.to_jshtml(default_mode=default_mode), animation_alt(anim))
+        return offline(_with_alt(anim.to_jshtml(default_mode=default_mode), animation_alt(anim)))
     import base64
     import tempfile
     from pathlib import Path
@@ -172,7 +208,7 @@ def to_html(anim, default_mode="loop"):
         writer.setup(anim._fig, path, dpi=anim._fig.dpi)
         writer._saved_frames = frames
         writer.finish()
-        return _with_alt(path.read_text(), animation_alt(anim))
+        return offline(_with_alt(path.read_text(), animation_alt(anim)))
 
 
 def show(anim, frame=None):

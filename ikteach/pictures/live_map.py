@@ -26,7 +26,7 @@ import numpy as np
 
 from ..core.chain import planar_chain
 from ..core.sweeps import sweep, target_grid
-from .workspace_maps import status_image
+from .workspace_maps import STATUS_COLOR_NAMES, STATUS_COLORS, status_image
 
 QUANTITIES = ("iterations", "error", "status")
 MAP_METHODS = ("dls", "jt")  # pinv, sdls: an SVD per step, seconds per map
@@ -68,18 +68,24 @@ def compute_map(arm, grid, theta0, method="dls", damping=0.5, quantity="iteratio
     return result, map_image(result, quantity)
 
 
+def _status_words():
+    """'green converged, orange stalled, ...' for every status, three to a line."""
+    words = [f"{STATUS_COLOR_NAMES[s]} {s}" for s in STATUS_COLORS]
+    return ",\n".join(", ".join(words[k:k + 3]) for k in range(0, len(words), 3))
+
+
 def _label(quantity, max_iter):
     return {"iterations": f"iterations, dark 0 to yellow {max_iter}",
             "error": "log10 of the final |e|, dark small to yellow large",
-            "status": "green converged, orange stalled,\nred max_iter, black diverged"}[quantity]
+            "status": _status_words()}[quantity]
 
 
 class LiveMap:
     """lambda slider, method and quantity dropdowns; each change redraws the map, solving
-    only a map not solved before."""
+    only a map not solved before. tol=None: the solver's default, L/3000 (as ik.solve_batch)."""
 
     def __init__(self, arm=None, grid_n=128, theta0=(0.3, 0.3, 0.3), method="dls",
-                 damping=0.5, quantity="iterations", tol=1e-3, max_iter=100, prefetch=True):
+                 damping=0.5, quantity="iterations", tol=None, max_iter=100, prefetch=True):
         import ipywidgets as w
 
         from .stills import with_still
@@ -128,7 +134,7 @@ class LiveMap:
         inches = SIZE / 100  # text in points is then points * 100 / 72 CSS pixels
         self._fig = Figure(figsize=(inches, inches), dpi=100 * HIDPI)
         self._canvas = FigureCanvasAgg(self._fig)
-        self._ax = ax = self._fig.add_axes((0.15, 0.11, 0.8, 0.71))
+        self._ax = ax = self._fig.add_axes((0.15, 0.12, 0.8, 0.64))  # room for 4 title lines
         self._im = ax.imshow(np.zeros(self.grid.shape), origin="lower", extent=self.grid.extent,
                              interpolation="nearest")
         ax.set_aspect("equal")

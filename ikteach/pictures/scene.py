@@ -273,14 +273,22 @@ def describe(arm, theta, target=None, trail=None, ghost=None):
     words = [f"3-D view of a {arm.n_joints}-joint arm (blue links, orange joints) on a grey floor, "
              f"end effector at ({T[0, 3]:.2f}, {T[1, 3]:.2f}, {T[2, 3]:.2f}) with its x/y/z "
              "frame drawn red/green/blue"]
+    scale = float(reach(arm))
     if target is not None:
         t = np.asarray(target, dtype=float)
+        kind = "a translucent purple sphere and x/y/z frame" if t.shape == (4, 4) else "a translucent purple sphere"
         t = t[:3, 3] if t.shape == (4, 4) else np.append(t, 0.0)[:3]
-        words.append(f"a translucent purple target at ({t[0]:.2f}, {t[1]:.2f}, {t[2]:.2f})")
+        gap = float(np.linalg.norm(t - T[:3, 3]))
+        where = ("at the end effector, hidden by its frame (reached)" if gap < 0.05 * scale
+                 else f"{gap:.2f} from the end effector")
+        words.append(f"the target at ({t[0]:.2f}, {t[1]:.2f}, {t[2]:.2f}) as {kind}, {where}")
     if ghost is not None:
         words.append("the start pose as a translucent ghost")
-    if trail is not None:
-        words.append("the end effector's path as a red trail")
+    if trail is not None and len(trail) > 1:
+        trail = np.asarray(trail, dtype=float)
+        length = float(np.linalg.norm(np.diff(trail, axis=0), axis=1).sum())
+        words.append(f"the end effector's path from ({trail[0, 0]:.2f}, {trail[0, 1]:.2f}, {trail[0, 2]:.2f}) "
+                     f"as a thin red tube {length:.2f} long")
     return "; ".join(words) + "."
 
 

@@ -30,7 +30,7 @@ def draw_tree(ax, arm, theta, targets=None, plane=(0, 1), color="C0"):
 def animate_tree(arm, thetas, targets, plane=(0, 1), limits=((-2.5, 4.0), (-1.0, 2.5)), interval=50,
                  times=None, title="tree"):
     """A FuncAnimation of the tree following its targets (one frame per row of thetas), titled
-    with the time of each frame (`times`, s) when given; show it with ik.pictures.plot.show (still frame)."""
+    with the time of each frame (`times`, Buss's τ) when given; show it with ik.pictures.plot.show (still frame)."""
     import matplotlib.pyplot as plt
 
     from .plot import _animation
@@ -51,7 +51,7 @@ def animate_tree(arm, thetas, targets, plane=(0, 1), limits=((-2.5, 4.0), (-1.0,
         joints.set_data(p[:, i], p[:, j])
         effs.set_data(x[:, i], x[:, j])
         tgt.set_data(targets[k][:, i], targets[k][:, j])
-        when = f"t = {times[k]:5.2f} s" if times is not None else f"frame {k}"
+        when = f"τ = {times[k]:5.2f}" if times is not None else f"frame {k}"  # Buss's time (his T)
         heading = ax.set_title(f"{title}: {when}", fontsize=9)
         return (*lines, joints, effs, tgt, heading)
 

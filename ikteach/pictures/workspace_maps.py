@@ -7,8 +7,11 @@ import numpy as np
 from ..core.sweeps import (Grid, SweepMap, Tracking, end_path, reach_radii, sigma_min,  # noqa: F401
                               sweep, target_grid, track)
 
+# one colour per status of ik.STATUSES (a status without one would be drawn white, like no target)
 STATUS_COLORS = {"converged": "#55a868", "stalled": "#dd8452", "max_iter": "#c44e52",
-                 "diverged": "#222222", "slow": "#8172b3"}
+                 "diverged": "#222222", "slow": "#8172b3", "singular": "#4c72b0", "damped": "#937860"}
+STATUS_COLOR_NAMES = {"converged": "green", "stalled": "orange", "max_iter": "red",
+                      "diverged": "black", "slow": "purple", "singular": "blue", "damped": "brown"}
 
 
 def boundary(mask, grid):
