@@ -19,8 +19,8 @@ PRINTED = {
     "pinv": ((pinv, "pinv_two_rows"), (pinv, "pinv_step")),      # lecture 03 prints both
     "dls": ((dls, "dls_step"), (dls, "dls_step")),               # lecture 04
     "sdls": ((sdls, "sdls_step"), (sdls, "sdls_step")),          # lecture 08
-    "ccd": ((ccd, "ccd_sweep"), (ccd, "ccd_sweep")),             # lecture 08
-    "fabrik": ((fabrik, "fabrik_pass"), (fabrik, "fabrik_pass")),  # lecture 08
+    "ccd": ((ccd, "ccd_angle"), (ccd, "ccd_angle")),             # lecture 08
+    "fabrik": ((fabrik, "fabrik_forward"), (fabrik, "fabrik_forward")),  # lecture 08
 }
 
 
