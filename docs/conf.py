@@ -30,6 +30,7 @@ html_theme = "sphinx_book_theme"
 html_title = "ikteach"
 html_static_path = ["_static"]
 html_css_files = ["book.css"]
+html_js_files = ["book.js"]
 html_context = {"default_mode": "light"}  # readable on a projector; the reader may switch
 html_copy_source = False
 html_show_sourcelink = False
@@ -40,3 +41,4 @@ html_theme_options = {
     "use_download_button": False,
     "show_toc_level": 2,
 }
+smartquotes = False  # the notebooks' text as written

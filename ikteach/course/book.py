@@ -231,7 +231,8 @@ def stage(root=ROOT, dest=STAGE):
             rewrite_links(text, f"docs/{guide}.md", h, mapping), encoding="utf-8")
     (dest / "notation.md").write_text(notation_page(root, h, mapping), encoding="utf-8")
     (dest / "index.md").write_text(home_page(root, h, thumbs), encoding="utf-8")
-    shutil.copy2(root / "docs" / "book.css", dest / "_static" / "book.css")
+    for name in ("book.css", "book.js"):
+        shutil.copy2(root / "docs" / name, dest / "_static" / name)
     shutil.copy2(root / "docs" / "conf.py", dest / "conf.py")
     copy_mathjax(dest / "_static")
     return dest
