@@ -11,7 +11,8 @@ committed notebooks are never changed), by these rules:
 - a Markdown cell that starts with a heading starts a new slide;
 - a long Markdown cell (a derivation) is split at its paragraphs into sub-slides (down arrow),
   each at most one screen (`BUDGET` lines at 1280 x 720);
-- a code cell with its output is a fragment of the slide it fits on, else a sub-slide of its own;
+- a code cell with its output is a fragment of the slide it fits on, else a sub-slide of its own
+  (one taller than a slide is shrunk to fit it when shown: slides_template);
 - the generated Colab set-up block of the first code cell is not shown.
 The same notebook always gives the same deck.
 """
