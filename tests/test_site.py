@@ -149,6 +149,14 @@ def test_no_page_loads_a_script_style_or_font_from_another_site(site, pages):
     assert found == {}
 
 
+def test_pages_with_widget_stills_say_the_live_version_needs_a_kernel(site):
+    for name in ("05_singularities_out_of_reach", "07_workspace_maps"):
+        text = page_text(site / "notebooks" / f"{name}.html")
+        assert "a still: run the notebook" in text  # the widget's still is on the page
+        assert "the live version needs a kernel" in text, name
+    assert "needs a kernel" not in page_text(site / "notebooks" / "01_jacobian.html")
+
+
 def test_math_is_served_by_the_site(site):
     text = (site / "notebooks" / "04_damped_least_squares.html").read_text(encoding="utf-8")
     script = re.search(r'<script[^>]+src="([^"?]*tex-svg-full\.js)[?"]', text)

@@ -39,6 +39,7 @@ GUIDES = ("students", "lecturers", "maintainers")
 LINK = re.compile(r"(\]\()([^)\s]+)(\))")
 DATA_IMG = re.compile(r"<img\b[^>]*>")
 WIDGET = "application/vnd.jupyter.widget-view+json"
+STILL = "(a still: run the notebook"  # the caption of a widget's still (pictures/stills.py)
 
 
 def lectures(root=ROOT):
@@ -98,8 +99,13 @@ def rewrite_links(text, repo_path, h, mapping):
 
 
 def has_widgets(book):
-    return any(WIDGET in out.get("data", {}) for cell in book["cells"]
-               for out in cell.get("outputs", []))
+    """True when an output is a widget or a widget's still (ikteach.pictures.stills)."""
+    for cell in book["cells"]:
+        for out in cell.get("outputs", []):
+            data = out.get("data", {})
+            if WIDGET in data or STILL in "".join(data.get("text/html", "")):
+                return True
+    return False
 
 
 def launch_cell(repo_path, h, widgets):
