@@ -32,7 +32,7 @@ HOME = home()
 OUT = ROOT / "build" / "slides"
 NODE = ROOT / "node_modules"
 TEMPLATES = Path(__file__).resolve().parent / "slides_template"
-BUDGET = 18         # lines of prose (20 px) that fit on one 1280 x 720 slide
+BUDGET = 20         # lines of prose (20 px, 30 px apart) that fit on one 1280 x 720 slide
 LINE_CHARS = 95     # characters per line of prose on a slide
 PICTURE_LINES = 14  # a figure or animation, shrunk to at most 430 px (slides_template)
 CODE_LINE = 0.8     # a line of code (17 px) or of printed output (14 px), in lines of prose
@@ -67,8 +67,10 @@ def markdown_lines(text):
     for line in text.split("\n"):
         if line.startswith("#"):
             lines += 2
+        elif line.strip() == "$$":
+            lines += 0.5  # a display's fence: its margin
         elif "$$" in line or line.strip().startswith("\\"):
-            lines += 1.5
+            lines += 1.2
         else:
             lines += max(1, math.ceil(len(line) / LINE_CHARS))
     return lines + 0.5
