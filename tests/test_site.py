@@ -187,3 +187,12 @@ def test_relative_links_become_pages_or_repository_links():
     assert "(../notation.md#notation)" in out
     assert f"({HOME.repository}/blob/{HOME.branch}/Makefile)" in out
     assert "(exercises/01_jacobian.ipynb)" in out
+
+
+def test_a_missing_repository_says_what_to_set(tmp_path):
+    for rel in ("docs", "notebooks"):
+        (tmp_path / rel).mkdir()
+    (tmp_path / "docs" / "conf.py").write_text("")
+    (tmp_path / "pyproject.toml").write_text('[project]\nname = "ikteach"\n')
+    with pytest.raises(SystemExit, match=r"\[project.urls\] Repository"):
+        book.stage(tmp_path, tmp_path / "src")

@@ -213,7 +213,15 @@ def copy_mathjax(static):
 def stage(root=ROOT, dest=STAGE):
     """Write the Sphinx source folder; returns it."""
     root, dest = Path(root), Path(dest)
-    h = home(root / "pyproject.toml")
+    if not (root / "docs" / "conf.py").is_file():
+        raise SystemExit(f"site: no docs/conf.py under {root}: build the book from a clone of "
+                         "the course's repository")
+    try:
+        h = home(root / "pyproject.toml")
+        h.github  # noqa: B018 - checks it is a GitHub repository URL
+    except (KeyError, ValueError) as exc:
+        raise SystemExit(f"site: name the course's repository in pyproject.toml, [project.urls] "
+                         f"Repository = \"https://github.com/OWNER/NAME\" ({exc})") from None
     shutil.rmtree(dest, ignore_errors=True)
     (dest / "_static" / "thumbs").mkdir(parents=True)
     mapping = pages(root)
