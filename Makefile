@@ -14,7 +14,7 @@ export UV_PYTHON_DOWNLOADS := never
 # may not write them itself, e.g. PYTHONDONTWRITEBYTECODE, a read-only venv).
 SYNC := $(UV) sync --locked --inexact --extra dev --compile-bytecode
 
-.PHONY: lab test test-latest test-lowest lock lock-upgrade header notebooks strip bench clean exercises test-browser bench-browser
+.PHONY: lab test test-latest test-lowest lock lock-upgrade header notebooks strip bench clean exercises test-browser bench-browser site slides node_modules
 
 # uv itself comes from PyPI, into the venv (the lock then keeps it at its locked version).
 $(UV):
@@ -44,7 +44,15 @@ EXERCISES = $(wildcard notebooks/exercises/*.ipynb) $(wildcard instructor/soluti
 NOTEBOOKS = $(wildcard notebooks/*.ipynb) $(EXERCISES)
 PYTEST_ARGS = -n 2 --dist loadfile tests $(NOTEBOOKS) --nbval --nbval-sanitize-with tests/nbval_sanitize.cfg --durations=15
 
-test: $(STAMP)
+# The browser assets of the book and the slides (MathJax, reveal.js) and axe-core, from npm at
+# the versions of package-lock.json. `make test` builds the book, so it needs them too.
+NODE_STAMP := node_modules/.package-lock.json
+$(NODE_STAMP): package.json package-lock.json
+	npm ci --no-audit --no-fund --loglevel=error
+	@touch $(NODE_STAMP)
+node_modules: $(NODE_STAMP)
+
+test: $(STAMP) $(NODE_STAMP)
 	$(PY) -m pytest $(PYTEST_ARGS)
 
 # The same suite against the newest versions pyproject.toml allows (not the lock), in its own
@@ -105,8 +113,16 @@ notebooks: $(STAMP)
 exercises: $(STAMP)
 	$(PY) -m ikteach.course.exercises build
 
+# The course as a static HTML book (build/site) and reveal.js slides (build/slides), from the
+# committed notebooks (never re-executed), offline: docs/lecturers.md, "Publish the course".
+site: $(STAMP) $(NODE_STAMP)
+	$(VENV)/bin/ikteach site
+
+slides: $(STAMP) $(NODE_STAMP)
+	$(VENV)/bin/ikteach slides
+
 clean:
-	rm -rf $(VENV) $(LATEST_VENV) $(LOWEST_VENV) .pytest_cache .hypothesis
+	rm -rf $(VENV) $(LATEST_VENV) $(LOWEST_VENV) .pytest_cache .hypothesis build node_modules
 
 # Benchmarks print tables (never part of make test). The peer libraries of the bench extra
 # go into their own venv, so that they never change what the tests run against.
@@ -120,11 +136,12 @@ bench: $(STAMP)
 # JupyterLab, drags the demo's slider and plays an animation, then runs every lecture notebook
 # (no error, nothing clipped, alt text on every image). Not part of `make test`.
 SUDO := $(if $(filter 0,$(shell id -u)),,sudo)
-test-browser: $(STAMP)
+test-browser: $(STAMP) $(NODE_STAMP)
 	@test -x /usr/bin/chromium -a -x /usr/bin/chromedriver || \
 	  { $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq chromium chromium-driver; }
 	$(PY) -m pip install --quiet "selenium>=4.20"
-	$(PY) -m pytest -v -p no:cacheprovider tests/browser/lab_05.py tests/browser/lab_notebooks.py
+	$(PY) -m pytest -v -p no:cacheprovider tests/browser/lab_05.py tests/browser/lab_notebooks.py \
+		tests/browser/site_book.py
 
 # Browser latency (a benchmark: prints p50/p95, asserts nothing): slider -> picture redrawn
 # in JupyterLab in headless Chromium. Run on an idle machine; not part of `make test`.

@@ -81,14 +81,14 @@ def test_header_is_added_to_a_new_notebook_and_idempotent(tmp_path):
 def test_header_follows_a_new_home(tmp_path):
     root = _copy_course(tmp_path)
     pyproject = root / "pyproject.toml"
-    pyproject.write_text(pyproject.read_text().replace("YOUR-ORG/ikteach", "a-school/ik-course"))
+    pyproject.write_text(pyproject.read_text().replace("ikteach-course/ikteach", "a-school/ik-course"))
     notebook_header.update(root)
     home = course_home.home(pyproject)
     for path in notebook_header.notebook_paths(root):
         source = _first_code(_load(path))
         assert source.count("%pip install") == 1
         assert '"ikteach @ git+https://github.com/a-school/ik-course@main"' in source
-    assert "github.com/YOUR-ORG" not in (root / "README.md").read_text()
+    assert "github.com/ikteach-course" not in (root / "README.md").read_text()
     assert home.binder_url("notebooks/01_jacobian.ipynb") in (root / "notebooks" / "README.md").read_text()
 
 

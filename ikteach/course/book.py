@@ -1,0 +1,282 @@
+"""The course as a static book: `make site` (or `ikteach site`).
+
+    python -m ikteach.course.book [--out build/site]
+
+Stages a Sphinx source folder (build/book-src) from what is committed, then runs Sphinx with
+myst-nb and sphinx-book-theme (docs/conf.py) into build/site:
+
+- the lecture notebooks and the exercise templates, as committed: never re-executed (the outputs
+  nbval checks are the outputs students read); the instructor's solutions are never read;
+- a home page (what the course teaches, one line and a picture per lecture), the notation table
+  of notebooks/README.md, and the guides of docs/ (students, lecturers, maintainers);
+- MathJax from the npm package (node_modules, `make node_modules`), copied into the site: the
+  book opens from disk with no network (a lecture hall).
+
+The staged copies (never the committed files) get a line of links at the top: "Open in Colab",
+"Binder" and "download the notebook", from the course's home in pyproject.toml. A relative link
+to a file of the repository that is not a page of the book points at the repository instead.
+"""
+import argparse
+import base64
+import html
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from .course_home import ROOT, home
+
+STAGE = ROOT / "build" / "book-src"
+OUT = ROOT / "build" / "site"
+MATHJAX = ROOT / "node_modules" / "mathjax" / "es5"
+MATHJAX_FILES = ("tex-svg-full.js", "a11y", "ui", "sre", "adaptors")  # what the page may load
+ORIGINALS = "_notebooks"  # the committed notebooks as they are, for "download the notebook"
+GUIDES = ("students", "lecturers", "maintainers")
+LINK = re.compile(r"(\]\()([^)\s]+)(\))")
+DATA_IMG = re.compile(r"<img\b[^>]*>")
+WIDGET = "application/vnd.jupyter.widget-view+json"
+STILL = "(a still: run the notebook"  # the caption of a widget's still (pictures/stills.py)
+
+
+def lectures(root=ROOT):
+    return sorted((Path(root) / "notebooks").glob("*.ipynb"))
+
+
+def exercises(root=ROOT):
+    return sorted((Path(root) / "notebooks" / "exercises").glob("*.ipynb"))
+
+
+def _source(cell):
+    source = cell.get("source", "")
+    return "".join(source) if isinstance(source, list) else source
+
+
+def title(book):
+    """The notebook's first Markdown heading."""
+    for cell in book["cells"]:
+        if cell["cell_type"] == "markdown":
+            match = re.search(r"^#\s+(.+)$", _source(cell), re.M)
+            if match:
+                return match.group(1).strip()
+    raise ValueError("notebook: expected a '# title' in a Markdown cell")
+
+
+def pages(root=ROOT):
+    """{repository path: book path} for every file that is a page of the book."""
+    root = Path(root)
+    mapping = {p.relative_to(root).as_posix(): p.relative_to(root).as_posix()
+               for p in lectures(root) + exercises(root)}
+    mapping.update({f"docs/{g}.md": f"guides/{g}.md" for g in GUIDES})
+    mapping["notebooks/README.md"] = "notation.md"
+    mapping["README.md"] = "index.md"
+    return mapping
+
+
+def rewrite_links(text, repo_path, h, mapping):
+    """Markdown text of the file at repo_path with relative links made right for the book."""
+    book_dir = Path(mapping.get(repo_path, repo_path)).parent
+
+    def fix(match):
+        target = match.group(2)
+        if re.match(r"[a-z]+:|#|/", target):
+            return match.group(0)
+        path, _, anchor = target.partition("#")
+        full = os.path.normpath(Path(repo_path).parent / path).replace(os.sep, "/")
+        if full in mapping:
+            new = os.path.relpath(mapping[full], book_dir).replace(os.sep, "/")
+            if full == "notebooks/README.md":
+                anchor = "notation"
+        else:
+            kind = "tree" if (ROOT / full).is_dir() else "blob"
+            new = f"{h.repository}/{kind}/{h.branch}/{full}"
+        return match.group(1) + new + (f"#{anchor}" if anchor else "") + match.group(3)
+
+    return LINK.sub(fix, text)
+
+
+def has_widgets(book):
+    """True when an output is a widget or a widget's still (ikteach.pictures.stills)."""
+    for cell in book["cells"]:
+        for out in cell.get("outputs", []):
+            data = out.get("data", {})
+            if WIDGET in data or STILL in "".join(data.get("text/html", "")):
+                return True
+    return False
+
+
+def launch_cell(repo_path, h, widgets):
+    """The Markdown cell put under a page's title: Colab, Binder, the notebook's download."""
+    original = os.path.relpath(f"{ORIGINALS}/{repo_path}", Path(repo_path).parent)
+    text = (f"[Open in Colab]({h.colab_url(repo_path)}) · [Binder]({h.binder_url(repo_path)}) · "
+            f"{{download}}`download the notebook <{original}>`")
+    if widgets:
+        text += ("\n\n*This page shows the interactive widgets as still pictures; the live "
+                 "version needs a kernel: open the notebook on Colab, Binder or your laptop.*")
+    return {"cell_type": "markdown", "metadata": {}, "source": text}
+
+
+def stage_notebook(src, root, h, mapping):
+    """The book's copy of a notebook: links fixed, the launch line under the title."""
+    repo_path = src.relative_to(root).as_posix()
+    book = json.loads(src.read_text(encoding="utf-8"))
+    for cell in book["cells"]:
+        if cell["cell_type"] == "markdown":
+            cell["source"] = rewrite_links(_source(cell), repo_path, h, mapping)
+    first = next(i for i, c in enumerate(book["cells"]) if c["cell_type"] == "markdown")
+    book["cells"].insert(first + 1, launch_cell(repo_path, h, has_widgets(book)))
+    for cell in book["cells"]:
+        cell.pop("id", None)
+    book["nbformat_minor"] = min(book.get("nbformat_minor", 4), 4)
+    return book
+
+
+def first_picture(book):
+    """(PNG bytes, alt text) of the notebook's first picture with alt text, or None."""
+    for cell in book["cells"]:
+        for out in cell.get("outputs", []):
+            data = out.get("data", {})
+            png = data.get("image/png")
+            alt = out.get("metadata", {}).get("image/png", {}).get("alt")
+            if png and alt:
+                return base64.b64decode("".join(png)), alt
+            for tag in DATA_IMG.findall("".join(data.get("text/html", ""))):
+                src = re.search(r'src="data:image/png;base64,([^"]+)"', tag)
+                alt = re.search(r'alt="([^"]+)"', tag)
+                if src and alt:
+                    return base64.b64decode(src.group(1)), html.unescape(alt.group(1))
+    return None
+
+
+def lecture_lines(root=ROOT):
+    """{notebook name: what it derives and checks}: the rows of notebooks/README.md's table."""
+    text = (Path(root) / "notebooks" / "README.md").read_text(encoding="utf-8")
+    rows = re.findall(r"^\|\s*`(\d\d_[\w-]+\.ipynb)`[^|]*\|\s*(.+?)\s*\|\s*$", text, re.M)
+    return {name: line.replace("\\|", "|") for name, line in rows}
+
+
+def home_page(root, h, thumbs):
+    """index.md: what the course teaches, then one line and a picture per lecture."""
+    lines = lecture_lines(root)
+    out = ["# Inverse kinematics, derived and run", "",
+           "Lecture notebooks and a small, tested Python module for the inverse-kinematics part "
+           "of a computer-animation course. Each lecture derives one method on the board (the "
+           "geometric Jacobian, Jacobian transpose with Buss's optimal step, the SVD "
+           "pseudoinverse, damped least squares, and beyond), checks every claim numerically "
+           "and animates the arm converging. Exercises are checked on the spot. Every page is "
+           "the committed, executed notebook; open it on Colab or Binder to run it.", "",
+           f"Source: [{h.github}]({h.repository}). Start with the "
+           "[students' guide](guides/students.md).", "", "## Lectures", ""]
+    for path in lectures(root):
+        book = json.loads(path.read_text(encoding="utf-8"))
+        out += [f"### [{title(book)}](notebooks/{path.name})", ""]
+        if path.stem in thumbs:
+            out += [f"![{thumbs[path.stem]}](_static/thumbs/{path.stem}.png)", ""]
+        out += [lines.get(path.name, ""), ""]
+    out += ["## Exercises", ""]
+    for path in exercises(root):
+        book = json.loads(path.read_text(encoding="utf-8"))
+        out.append(f"- [{title(book)}](notebooks/exercises/{path.name})")
+    out += ["", toctree("Lectures", [f"notebooks/{p.stem}" for p in lectures(root)]),
+            toctree("Exercises", [f"notebooks/exercises/{p.stem}" for p in exercises(root)]),
+            toctree("Reference", ["notation"]),
+            toctree("Guides", [f"guides/{g}" for g in GUIDES])]
+    return "\n".join(out) + "\n"
+
+
+def toctree(caption, entries):
+    return "\n".join(["```{toctree}", ":hidden:", f":caption: {caption}", "", *entries, "```", ""])
+
+
+def notation_page(root, h, mapping):
+    """notation.md: the notation section of notebooks/README.md."""
+    text = (Path(root) / "notebooks" / "README.md").read_text(encoding="utf-8")
+    start = text.index('<a id="notation"></a>')
+    section = text[start:].split("\n", 1)[1]
+    section = re.sub(r"^## Notation.*$", "# Notation", section, count=1, flags=re.M)
+    return rewrite_links(section, "notebooks/README.md", h, mapping)
+
+
+def copy_mathjax(static):
+    (static / "mathjax").mkdir(parents=True, exist_ok=True)
+    if not (MATHJAX / MATHJAX_FILES[0]).is_file():
+        raise SystemExit(f"site: MathJax is missing ({MATHJAX}): run `make node_modules` "
+                         "(npm ci: installs package-lock.json's MathJax and reveal.js)")
+    for name in MATHJAX_FILES:
+        src, dst = MATHJAX / name, static / "mathjax" / name
+        (shutil.copytree if src.is_dir() else shutil.copy2)(src, dst)
+
+
+def stage(root=ROOT, dest=STAGE):
+    """Write the Sphinx source folder; returns it."""
+    root, dest = Path(root), Path(dest)
+    if not (root / "docs" / "conf.py").is_file():
+        raise SystemExit(f"site: no docs/conf.py under {root}: build the book from a clone of "
+                         "the course's repository")
+    try:
+        h = home(root / "pyproject.toml")
+        h.github  # noqa: B018 - checks it is a GitHub repository URL
+    except (KeyError, ValueError) as exc:
+        raise SystemExit(f"site: name the course's repository in pyproject.toml, [project.urls] "
+                         f"Repository = \"https://github.com/OWNER/NAME\" ({exc})") from None
+    shutil.rmtree(dest, ignore_errors=True)
+    (dest / "_static" / "thumbs").mkdir(parents=True)
+    mapping = pages(root)
+    thumbs = {}
+    for src in lectures(root) + exercises(root):
+        book = stage_notebook(src, root, h, mapping)
+        target = dest / src.relative_to(root)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.write_text(json.dumps(book, ensure_ascii=False), encoding="utf-8")
+        original = dest / ORIGINALS / src.relative_to(root)
+        original.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(src, original)
+        picture = first_picture(book) if src.parent.name == "notebooks" else None
+        if picture:
+            (dest / "_static" / "thumbs" / f"{src.stem}.png").write_bytes(picture[0])
+            thumbs[src.stem] = picture[1].replace("[", "(").replace("]", ")")
+    for guide in GUIDES:
+        text = (root / "docs" / f"{guide}.md").read_text(encoding="utf-8")
+        (dest / "guides").mkdir(exist_ok=True)
+        (dest / "guides" / f"{guide}.md").write_text(
+            rewrite_links(text, f"docs/{guide}.md", h, mapping), encoding="utf-8")
+    (dest / "notation.md").write_text(notation_page(root, h, mapping), encoding="utf-8")
+    (dest / "index.md").write_text(home_page(root, h, thumbs), encoding="utf-8")
+    for name in ("book.css", "book.js"):
+        shutil.copy2(root / "docs" / name, dest / "_static" / name)
+    shutil.copy2(root / "docs" / "conf.py", dest / "conf.py")
+    copy_mathjax(dest / "_static")
+    return dest
+
+
+def build(out=OUT, root=ROOT, quiet=True):
+    """Stage and run Sphinx (docs/conf.py); returns the output folder."""
+    src = stage(root)
+    shutil.rmtree(out, ignore_errors=True)  # nothing left over from an earlier build
+    cmd = [sys.executable, "-m", "sphinx", "-b", "html",
+           "-j", "auto", "-E", str(src), str(out)] + (["-q"] if quiet else [])
+    subprocess.run(cmd, check=True)
+    return Path(out)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="ikteach site", description=__doc__.split("\n")[0])
+    parser.add_argument("--out", type=Path, default=OUT, help="output folder (build/site)")
+    args = parser.parse_args(argv)
+    start = time.perf_counter()
+    try:
+        out = build(args.out)
+    except subprocess.CalledProcessError as exc:
+        print(f"site: sphinx-build failed (exit status {exc.returncode})", file=sys.stderr)
+        return 1
+    pages_built = len(list(out.rglob("*.html"))) - len(list((out / "_static").rglob("*.html")))
+    print(f"site: {pages_built} pages in {out} ({time.perf_counter() - start:.0f} s); "
+          f"open {out / 'index.html'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,68 @@
+"""make slides: slide metadata decided at build time (the committed notebooks untouched), and a
+deck that loads reveal.js and MathJax from next to itself."""
+import json
+import re
+from pathlib import Path
+
+from ikteach.course import slides
+
+ROOT = Path(__file__).resolve().parents[1]
+LECTURE = ROOT / "notebooks" / "04_damped_least_squares.ipynb"
+
+
+def _notebook(*cells):
+    return {"cells": [{"cell_type": kind, "metadata": {}, "source": source,
+                       **({"outputs": outputs, "execution_count": 1} if kind == "code" else {})}
+                      for kind, source, outputs in cells],
+            "metadata": {}, "nbformat": 4, "nbformat_minor": 5}
+
+
+def _kinds(book):
+    return [cell["metadata"]["slideshow"]["slide_type"] for cell in slides.slide_cells(book)]
+
+
+def test_headings_start_slides_and_code_is_a_fragment():
+    book = _notebook(("markdown", "# Title\n\nOne line.", None),
+                     ("code", slides.SETUP + "\nimport sys", []),
+                     ("markdown", "## Section\n\nA short paragraph.", None),
+                     ("code", "x = 1\nprint(x)", [{"output_type": "stream", "name": "stdout",
+                                                   "text": "1\n"}]))
+    assert _kinds(book) == ["slide", "-", "skip", "slide", "-", "fragment"]
+
+
+def test_a_long_derivation_continues_on_sub_slides():
+    steps = "\n\n".join(f"Step {i}: " + "words " * 60 + f"\n$$\nx_{i} = y_{i}\n$$" for i in range(8))
+    kinds = _kinds(_notebook(("markdown", "## Derivation\n\n" + steps, None)))
+    assert kinds[0] == "slide" and kinds.count("subslide") >= 2
+    assert set(kinds[1:]) <= {"-", "subslide"}
+
+
+def test_display_math_is_never_cut():
+    text = "Before.\n\n$$\na = b\n\nc = d\n$$\n\nAfter."
+    assert slides.paragraphs(text) == ["Before.", "$$\na = b\nc = d\n$$", "After."]
+
+
+def test_slides_are_decided_on_a_copy_the_same_every_time():
+    committed = LECTURE.read_text(encoding="utf-8")
+    book = json.loads(committed)
+    first, second = slides.slide_notebook(book), slides.slide_notebook(book)
+    assert first == second
+    assert LECTURE.read_text(encoding="utf-8") == committed
+    kinds = [c["metadata"]["slideshow"]["slide_type"] for c in first["cells"]]
+    headings = sum(1 for c in book["cells"] if c["cell_type"] == "markdown"
+                   and "".join(c["source"]).lstrip().startswith("#"))
+    assert kinds.count("slide") >= headings and "subslide" in kinds
+
+
+def test_a_deck_loads_its_scripts_from_next_to_itself(tmp_path):
+    deck, = slides.build([LECTURE], tmp_path)
+    text = deck.read_text(encoding="utf-8")
+    sources = re.findall(r'<script[^>]+src="([^"]+)"', text)
+    assert "reveal.js/dist/reveal.js" in sources and "mathjax/tex-svg-full.js" in sources
+    for src in sources:
+        assert not re.match(r"(https?:)?//", src), src
+        assert (tmp_path / src).is_file(), src
+    for href in re.findall(r'<link[^>]+href="([^"]+)"', text):
+        if not re.match(r"(https?:)?//", href):
+            assert (tmp_path / href).is_file(), href
+    assert "unpkg.com" not in text and "cdnjs" not in text and "require.js" not in text
