@@ -47,25 +47,27 @@ def start(theta0):
 
 
 def stop_rule(options, state, error):
-    """The stops in the order they are checked; RUNNING when none fires."""
-    stalled = (state.i > 0) & (state.step < options.stall_tol)
-    status = jnp.where(state.i >= options.max_iter, MAX_ITER, RUNNING)
-    status = jnp.where(stalled, jnp.where(still_progressing(state.error, error), SLOW, STALLED),
-                       status)
-    status = jnp.where(error < options.tol, CONVERGED, status)
-    return jnp.where(jnp.isfinite(error), status, DIVERGED)
+    """Which stop fires at this pass, the first that holds in this order; RUNNING if none."""
+    stalled = (state.i > 0) & (state.step < options.stall_tol)   # the last step was tiny
+    return jnp.select(
+        [~jnp.isfinite(error),                                    # diverged
+         error < options.tol,                                     # converged
+         stalled & still_progressing(state.error, error),         # slow: ||e|| still falls
+         stalled,                                                 # stalled
+         state.i >= options.max_iter],                            # max_iter
+        [DIVERGED, CONVERGED, SLOW, STALLED, MAX_ITER], RUNNING)
 
 
 def iterate(problem, method, options, state):
     """One pass of the loop: look at e, then stop or take one step."""
-    e, J = problem.error_and_jacobian(state.theta)
+    e, J = problem.error_and_jacobian(state.theta)                # e = target - F(theta), J
     error = jnp.linalg.norm(e)
-    status = stop_rule(options, state, error)
+    status = stop_rule(options, state, error)                     # checked before any step
     delta = method.delta(problem, state.theta, clamp_error(e, options.clamp), J)
-    delta = cap_step(delta, options.max_step)
+    delta = cap_step(delta, options.max_step)                     # Buss's safeguards
     theta = jnp.clip(state.theta + delta, *options.joint_limits)
     status = jnp.where((status == RUNNING) & ~jnp.all(jnp.isfinite(theta)), DIVERGED, status)
-    moving = status == RUNNING
+    moving = status == RUNNING                                    # a stopped loop keeps theta
     return State(state.i + moving, jnp.where(moving, theta, state.theta), error,
                  jnp.where(moving, step_size(options.stop_rule, J, delta), state.step), status)
 
