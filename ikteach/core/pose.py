@@ -3,7 +3,14 @@
 A pose is a 4x4 homogeneous transform T = [[R, p], [0, 1]]. The pose error stacks the
 position error and the orientation error as an axis-angle vector:
 
-    e = [ beta_p (p_t - p(theta)) ;  beta_o log(R_t R(theta)^T) ]          (6,)
+    e = [ beta_p (p_t - p(theta)) ;  beta_o L log(R_t R(theta)^T) ]          (6,)
+
+L is the arm's reach (the sum of its link lengths, ik.reach): an angle times a length is a
+length, so every entry of e is a length and the solve's lengths (tol = L / 3000, damping
+lambda = L / 6, stall_tol = tol / 100) mean the same at every unit. Scale the arm by s and
+e, J and those lengths all scale by s: metres and millimetres give the same steps. With
+the default weights, "converged" (||e|| < tol) means a position error below tol and an
+orientation error below tol / L radians (1/3000 rad with the default tol) - both at once.
 
 log(R_t R^T) is the rotation vector omega with R_t = exp([omega]x) R: the small rotation
 that takes the current hand to the target, in world coordinates. Its derivative at
@@ -99,7 +106,8 @@ def orientation_error(R_target, R):
 class PoseTask:
     """Reach a 4x4 pose with a spatial chain.
 
-    e = [beta_p (p_t - p); beta_o log(R_t R^T)],  J = diag(beta_p I, beta_o I) [z_i x (p_e - p_i); z_i].
+    e = [beta_p (p_t - p); beta_o L log(R_t R^T)],  J = diag(beta_p I, beta_o L I) [z_i x (p_e - p_i); z_i],
+    L the arm's reach (module doc: every row is then a length).
     The weights are the task's data (a pytree leaf each): traced, so new weights reuse the
     compiled loop (ik.solve(..., weights=(beta_p, beta_o)) makes a new task, not a program).
     """
@@ -122,11 +130,15 @@ class PoseTask:
         positions, _, R = joint_frames(arm, theta)
         e_p = target[:3, 3] - positions[-1]
         e_o = orientation_error(target[:3, :3], R)
-        return jnp.concatenate([self.position_weight * e_p, self.orientation_weight * e_o])
+        return jnp.concatenate([self.position_weight * e_p, self.orientation_scale(arm) * e_o])
 
     def jacobian(self, arm, theta):
         J = jacobian(arm, theta, full=True)
-        return jnp.vstack([self.position_weight * J[:3], self.orientation_weight * J[3:]])
+        return jnp.vstack([self.position_weight * J[:3], self.orientation_scale(arm) * J[3:]])
+
+    def orientation_scale(self, arm):
+        """beta_o L: radians of orientation error to the length they count as in e."""
+        return self.orientation_weight * arm_length(arm)
 
     def length_scale(self, arm):
         return float(reach(arm))
@@ -147,6 +159,11 @@ class PoseTask:
 
 jax.tree_util.register_dataclass(PoseTask, data_fields=["position_weight", "orientation_weight"],
                                  meta_fields=[])
+
+
+def arm_length(arm):
+    """The arm's reach L = sum_i |offsets[i]| (traceable: ik.reach for the loop's arm)."""
+    return jnp.sum(jnp.linalg.norm(jnp.asarray(arm.offsets), axis=1))
 
 
 RIGID_TOL = 1e-6  # largest |R^T R - I| entry and |bottom row - [0, 0, 0, 1]| accepted

@@ -18,17 +18,36 @@ the relative progress of the last step, (||e_prev|| - ||e||) / ||e_prev||, tells
 above SLOW_PROGRESS the status is "slow" instead of "stalled".
 
 A step can also be small for reasons that say nothing about reach; stall_kind looks at the
-theta where the solve stopped and tells three cases apart (with g = J^T e, the direction
-that lowers 1/2 ||e||^2, and H its Hessian):
+theta where the solve stopped and tells four cases apart. A solve with priority levels has one
+error block e_k per level (level 0 first; a rest pose is not one: it is not part of ||e||); a
+plain solve has one level, e itself. Two tests, each in the problem's own scale (sigma_max, the
+largest singular value of J, turns a length into the error's units):
 
-  "stalled"   ||g|| < GRADIENT_FRACTION sigma_max ||e|| (J cannot see the error any more) and
-              H has no clearly negative eigenvalue: a minimum of ||e||, the target is out of
-              reach (of this start's basin);
-  "singular"  the same small g, but H < -CURVATURE_FRACTION sigma_max^2 along some direction:
-              a saddle, e.g. a straight arm whose target lies on its own line. Reachable;
-              a nudge of the start gets the solve going;
-  "damped"    g is not small: J sees the error, but the steps were cut (a large damping
-              lambda, max_step or clamp for this arm's size). Not out of reach.
+  projected gradient  g_k = N_<k J_k^T e_k, the direction that lowers 1/2 ||e_k||^2 without
+              touching the levels before it (N_<k: the null space of their Jacobians; N = I for
+              level 0). Small when ||g_k|| <= GRADIENT_FRACTION sigma_max ||e|| for every level.
+  probe       a weak direction of J (sigma_i << sigma_max) keeps g small although the error
+              lies along it; so also try what a lighter step would do: the priority step
+              (ik.multilevel_step; DLS for one level) with damping lambda = f sigma_max,
+              f in LIGHT_DAMPINGS, each turn capped at PROBE_MAX_TURN radians and taken at
+              PROBE_FRACTIONS of its length. It improves when some level's ||e_k|| falls by
+              more than IMPROVABLE ||e|| while no level before it grows by as much.
+
+  MINIMUM      "stalled": g small and no probe improves, and the Hessian H_k of 1/2 ||e_k||^2
+               (within N_<k) has no clearly negative eigenvalue: a minimum of ||e|| - the
+               target is out of reach of this start (another start may reach it: a local
+               minimum looks the same from inside);
+  SADDLE       "singular": the same, but H_k < -CURVATURE_FRACTION sigma_max^2 along some
+               direction: a saddle, e.g. a straight arm whose target lies on its own line.
+               Reachable; a nudge of the start gets the solve going;
+  CUT_SHORT    "damped": g is not small or a lighter step would still lower ||e||: the
+               method's steps, not the target, stopped the solve (a large damping lambda,
+               max_step or clamp for this arm's size, or J's weak direction). Not out of reach;
+  FIXED_POINT  "fixed_point": as CUT_SHORT, but for a method that is not a Jacobian step
+               (FABRIK, CCD) run without max_step: its own update has a fixed point there
+               (FABRIK's hinge recovery on a spatial chain, say). Not out of reach; a Jacobian
+               method (dls, pinv) goes on from there.
+KIND_STATUS names the status each kind reports.
 Joints resting on a joint limit and pushed against it count as fixed.
 """
 from functools import partial
@@ -37,16 +56,25 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .ccd import CCDMethod
+from .fabrik import FABRIKMethod
 from .joint_limits import LimitedMethod
-from .levels import PriorityMethod
+from .levels import PriorityMethod, block_size
+from .limits import cap_step
+from .priority import multilevel_step, null_projector
 from .._runtime import jit as runtime_jit
 
 STOP_RULES = ("joint_steps", "motion")
 DEFAULT_STOP_RULE = "motion"
 SLOW_PROGRESS = 1e-4  # "slow" when ||e|| still fell by more than this fraction in the last step
-GRADIENT_FRACTION = 1e-2  # stationary: ||J^T e|| below this fraction of sigma_max ||e||
+GRADIENT_FRACTION = 1e-2  # a small projected gradient: below this fraction of sigma_max ||e||
 CURVATURE_FRACTION = 1e-6  # a saddle: an eigenvalue of H below -this fraction of sigma_max^2
-MINIMUM, SADDLE, CUT_SHORT = range(3)  # what stall_kind returns
+LIGHT_DAMPINGS = (1e-1, 1e-2, 1e-3)  # the probe steps' lambda, as fractions of sigma_max
+PROBE_FRACTIONS = (1.0, 0.25, 0.0625)  # each probe step is tried at these fractions of its length
+PROBE_MAX_TURN = 0.1  # radians: a probe step stays near theta (it tests the neighbourhood)
+IMPROVABLE = 1e-3  # a probe that lowers a level's ||e_k|| by this fraction of ||e||: not a minimum
+MINIMUM, SADDLE, CUT_SHORT, FIXED_POINT = range(4)  # what stall_kind returns
+KIND_STATUS = ("stalled", "singular", "damped", "fixed_point")  # the status each kind reports
 
 
 def rule_index(rule):
@@ -89,47 +117,128 @@ def still_progressing(previous_error, error):
     return relative_progress(previous_error, error) > SLOW_PROGRESS
 
 
-def stall_kind(task, arm, target, theta, lower, upper):
-    """Why a solve stalled at theta: MINIMUM (out of reach), SADDLE or CUT_SHORT (module doc)."""
-    e = task.error(arm, target, theta)
+def level_norms(e, levels):
+    """||e_k|| for each level k (levels: the error's row indices, level 0 first)."""
+    return jnp.stack([jnp.linalg.norm(e[jnp.asarray(rows)]) for rows in levels])
+
+
+def level_projectors(J, levels):
+    """N_<k for each level k: the null space of the Jacobians of the levels before it."""
+    n = J.shape[1]
+    done = [jnp.concatenate([jnp.asarray(r) for r in levels[:k]]) for k in range(1, len(levels))]
+    return [jnp.eye(n)] + [null_projector(J[rows]) for rows in done]
+
+
+def gradient_small(J, e, levels, projectors, sigma_max):
+    """Every level's projected gradient N_<k J_k^T e_k below GRADIENT_FRACTION sigma_max ||e||."""
+    bound = GRADIENT_FRACTION * sigma_max * jnp.linalg.norm(e)
+    norms = [jnp.linalg.norm(N @ (J[jnp.asarray(r)].T @ e[jnp.asarray(r)]))
+             for r, N in zip(levels, projectors)]
+    return jnp.all(jnp.stack(norms) <= bound)
+
+
+def lexicographic_gain(before, after, scale):
+    """Does `after` improve on `before` level by level: some level falls by more than
+    IMPROVABLE scale while none before it rises by as much?"""
+    change = (before - after) / scale
+    safe_so_far = jnp.cumprod(jnp.concatenate([jnp.ones(1), (change > -IMPROVABLE)[:-1]]))
+    return jnp.any((change > IMPROVABLE) & (safe_so_far > 0))
+
+
+def probe_improves(error_of, J, e, theta, levels, sigma_max, lower, upper):
+    """Would a lighter step still lower ||e||? (module doc: the probe). J's pinned columns are
+    zeroed by the caller, so the probe steps leave those joints where they are."""
+    before = level_norms(e, levels)
+    scale = jnp.where(jnp.linalg.norm(e) > 0, jnp.linalg.norm(e), 1.0)
+    parts = [(J[jnp.asarray(r)], e[jnp.asarray(r)]) for r in levels]
+    gains = []
+    for fraction in LIGHT_DAMPINGS:
+        delta = cap_step(multilevel_step(parts, fraction * sigma_max), PROBE_MAX_TURN)
+        for t in PROBE_FRACTIONS:
+            after = level_norms(error_of(jnp.clip(theta + t * delta, lower, upper)), levels)
+            gains.append(lexicographic_gain(before, after, scale))
+    return jnp.any(jnp.stack(gains))
+
+
+def saddle_of_levels(error_of, theta, levels, projectors, pinned, sigma_max):
+    """Some level's Hessian of 1/2 ||e_k||^2, within N_<k and the free joints, clearly negative."""
+    lowest = []
+    for rows, N in zip(levels, projectors):
+        half_sq = lambda q, rows=rows: 0.5 * jnp.sum(error_of(q)[jnp.asarray(rows)] ** 2)
+        H = N @ jax.hessian(half_sq)(theta) @ N
+        H = jnp.where(pinned[:, None] | pinned[None, :], 0.0, H)
+        lowest.append(jnp.linalg.eigvalsh(H)[0])
+    return jnp.min(jnp.stack(lowest)) < -CURVATURE_FRACTION * sigma_max**2
+
+
+def stall_kind(task, arm, target, theta, lower, upper, levels=None):
+    """Why a solve stalled at theta: MINIMUM (out of reach), SADDLE or CUT_SHORT (module doc).
+
+    levels: the error's row indices per priority level, level 0 first (a tuple of tuples;
+    None: one level, the whole error - a plain solve)."""
+    error_of = lambda q: task.error(arm, target, q)
+    e = error_of(theta)
+    levels = (tuple(range(e.shape[0])),) if levels is None else levels
     J = task.jacobian(arm, theta)
     g = J.T @ e
     pinned = ((theta <= lower) & (g < 0)) | ((theta >= upper) & (g > 0))  # pushed into a limit
-    g = jnp.where(pinned, 0.0, g)
+    J = jnp.where(pinned[None, :], 0.0, J)
     sigma_max = jnp.linalg.norm(J, 2)
-    stationary = jnp.linalg.norm(g) <= GRADIENT_FRACTION * sigma_max * jnp.linalg.norm(e)
-    half_sq = lambda q: 0.5 * jnp.sum(task.error(arm, target, q) ** 2)
-    H = jax.hessian(half_sq)(theta)
-    H = jnp.where(pinned[:, None] | pinned[None, :], 0.0, H)
-    saddle = jnp.linalg.eigvalsh(H)[0] < -CURVATURE_FRACTION * sigma_max**2
+    projectors = level_projectors(J, levels)
+    stationary = gradient_small(J, e, levels, projectors, sigma_max) & \
+        ~probe_improves(error_of, J, e, theta, levels, sigma_max, lower, upper)
+    saddle = saddle_of_levels(error_of, theta, levels, projectors, pinned, sigma_max)
     return jnp.where(stationary, jnp.where(saddle, SADDLE, MINIMUM), CUT_SHORT)
 
 
 STALL_BLOCKS = (8, 1024)  # rows per call: a solve's, a batch's
 
 
-@partial(runtime_jit.jit, static_argnames=("task",))
-def _stall_kinds(task, arm, targets, thetas, lower, upper):
-    return jax.vmap(lambda t, q: stall_kind(task, arm, t, q, lower, upper))(targets, thetas)
+@partial(runtime_jit.jit, static_argnames=("task", "levels"))
+def _stall_kinds(task, arm, targets, thetas, lower, upper, levels):
+    return jax.vmap(lambda t, q: stall_kind(task, arm, t, q, lower, upper, levels))(targets, thetas)
+
+
+def priority_levels(method, task, rows):
+    """The error's row indices per priority level (static tuples), level 0 first: the
+    method's levels for a prioritised solve (its rest pose is no level of ||e||), else one."""
+    if not isinstance(method, PriorityMethod):
+        return (tuple(range(rows)),)
+    return tuple(tuple(int(i) for i in r)
+                 for r in method.rows_by_level(rows, block_size(task, rows)))
+
+
+def own_update(method, settings):
+    """FABRIK and CCD without max_step: a stop they cut short is their own fixed point."""
+    return isinstance(method, (FABRIKMethod, CCDMethod)) and not np.isfinite(settings.max_step)
 
 
 def why_stalled(method, task, arm, targets, thetas, stalled, settings):
-    """stall_kind of every row where `stalled` (MINIMUM elsewhere). Rows go in blocks of
+    """stall_kind of every row where `stalled` (MINIMUM elsewhere); CUT_SHORT becomes
+    FIXED_POINT for FABRIK and CCD without max_step (own_update). Rows go in blocks of
     STALL_BLOCKS[0] (a few rows: a solve) or STALL_BLOCKS[1] (a batch), the last one padded:
     two compiled programs per problem, whatever the count (a new count would otherwise compile
-    again: 0.3-0.5 s on a live map's lambda change). Prioritised solves (levels, a rest pose) stop
-    at a compromise between levels, not at a minimum of ||e||: they are left as they are."""
+    again: 0.3-0.5 s on a live map's lambda change). Prioritised solves (levels, a rest pose)
+    are judged level by level (priority_levels).
+
+    The loop calls it once, after the loop: targets (B, ...) and thetas (B, n) where each
+    row stopped, stalled (B,) True where the row ended STALLED, settings the solve's
+    (lower, upper, max_step); KIND_STATUS[kind] is the status each stalled row reports."""
     kinds = np.full(np.shape(stalled), MINIMUM)
     rows = np.flatnonzero(stalled)
-    inner = method.inner if isinstance(method, LimitedMethod) else method
-    if rows.size == 0 or isinstance(inner, PriorityMethod):
+    if rows.size == 0:
         return kinds
+    inner = method.inner if isinstance(method, LimitedMethod) else method
+    targets, thetas = np.asarray(targets), np.asarray(thetas)
+    n_rows = jax.eval_shape(lambda q: task.error(arm, targets[0], q), thetas[0]).shape[0]
+    levels = priority_levels(inner, task, n_rows)
     block = STALL_BLOCKS[0] if rows.size <= STALL_BLOCKS[0] else STALL_BLOCKS[1]
     padded = np.concatenate([rows, np.repeat(rows[-1:], -rows.size % block)])
     n = np.shape(thetas)[-1]
     bounds = [np.broadcast_to(np.asarray(b, dtype=float), (n,)) for b in (settings.lower, settings.upper)]
-    targets, thetas = np.asarray(targets), np.asarray(thetas)
-    found = [_stall_kinds(task, arm, targets[part], thetas[part], *bounds)
+    found = [_stall_kinds(task, arm, targets[part], thetas[part], *bounds, levels)
              for part in padded.reshape(-1, block)]
     kinds[rows] = np.concatenate([np.asarray(f) for f in found])[: rows.size]
+    if own_update(inner, settings):
+        kinds[kinds == CUT_SHORT] = FIXED_POINT
     return kinds
