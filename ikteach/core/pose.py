@@ -23,7 +23,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ._validate import as_number
+from ._validate import as_array, as_number
 from .chain import Chain, reach
 from .jacobian import jacobian
 from .kinematics import joint_frames, skew
@@ -194,7 +194,11 @@ def check_pose(T, name="target"):
 
 
 def pose_errors(arm, theta, target):
-    """(position error |p_t - p|, orientation error angle in radians) of theta for a 4x4 target."""
+    """(position error |p_t - p|, orientation error angle in radians) of theta for a 4x4 target.
+
+    target must be a rigid transform (check_pose: a ValueError naming target otherwise)."""
+    target = as_array(target, "target", shape=(4, 4))
+    check_pose(target, "target")
     T = fk_pose(arm, theta)
     target = jnp.asarray(target)
     e_p = jnp.linalg.norm(target[:3, 3] - T[:3, 3])
@@ -203,7 +207,12 @@ def pose_errors(arm, theta, target):
 
 
 def make_pose(R, p):
-    """The 4x4 transform [[R, p], [0, 1]] from a rotation matrix and a position."""
+    """The 4x4 transform [[R, p], [0, 1]] from a rotation matrix R (3, 3) and a position p (3,).
+
+    Numbers given (not traced) are checked: a ValueError naming R or p for a wrong shape or
+    non-finite entries. (Whether R is a rotation is ik.solve's check: check_pose.)"""
+    if not any(isinstance(x, jax.core.Tracer) for x in (R, p)):
+        R, p = as_array(R, "R", shape=(3, 3)), as_array(p, "p", shape=(3,))
     top = jnp.hstack([jnp.asarray(R, dtype=float), jnp.asarray(p, dtype=float)[:, None]])
     return jnp.vstack([top, jnp.array([[0.0, 0.0, 0.0, 1.0]])])
 
