@@ -33,11 +33,11 @@ largest singular value of J, turns a length into the error's units):
               PROBE_FRACTIONS of its length. It improves when some level's ||e_k|| falls by
               more than IMPROVABLE ||e|| while no level before it grows by as much.
 
-  MINIMUM      "stalled": g small and no probe improves, and the Hessian H_k of 1/2 ||e_k||^2
-               (within N_<k) has no clearly negative eigenvalue: a minimum of ||e|| - the
+  MINIMUM      "stalled": g small and no probe improves, and the Hessian H of 1/2 ||e_0||^2
+               (level 0) has no clearly negative eigenvalue: a minimum of ||e|| - the
                target is out of reach of this start (another start may reach it: a local
                minimum looks the same from inside);
-  SADDLE       "singular": the same, but H_k < -CURVATURE_FRACTION sigma_max^2 along some
+  SADDLE       "singular": the same, but H < -CURVATURE_FRACTION sigma_max^2 along some
                direction: a saddle, e.g. a straight arm whose target lies on its own line.
                Reachable; a nudge of the start gets the solve going;
   CUT_SHORT    "damped": g is not small or a lighter step would still lower ||e||: the
@@ -160,15 +160,13 @@ def probe_improves(error_of, J, e, theta, levels, sigma_max, lower, upper):
     return jnp.any(jnp.stack(gains))
 
 
-def saddle_of_levels(error_of, theta, levels, projectors, pinned, sigma_max):
-    """Some level's Hessian of 1/2 ||e_k||^2, within N_<k and the free joints, clearly negative."""
-    lowest = []
-    for rows, N in zip(levels, projectors):
-        half_sq = lambda q, rows=rows: 0.5 * jnp.sum(error_of(q)[jnp.asarray(rows)] ** 2)
-        H = N @ jax.hessian(half_sq)(theta) @ N
-        H = jnp.where(pinned[:, None] | pinned[None, :], 0.0, H)
-        lowest.append(jnp.linalg.eigvalsh(H)[0])
-    return jnp.min(jnp.stack(lowest)) < -CURVATURE_FRACTION * sigma_max**2
+def saddle(error_of, theta, rows, pinned, sigma_max):
+    """The Hessian of 1/2 ||e_0||^2 (level 0's rows, the free joints) clearly negative somewhere.
+    Only level 0: a later level moves on the curved set where the levels before it stay met,
+    whose curvature its own Hessian does not see (a saddle there reads as a minimum)."""
+    half_sq = lambda q: 0.5 * jnp.sum(error_of(q)[jnp.asarray(rows)] ** 2)
+    H = jnp.where(pinned[:, None] | pinned[None, :], 0.0, jax.hessian(half_sq)(theta))
+    return jnp.linalg.eigvalsh(H)[0] < -CURVATURE_FRACTION * sigma_max**2
 
 
 def stall_kind(task, arm, target, theta, lower, upper, levels=None):
@@ -187,8 +185,8 @@ def stall_kind(task, arm, target, theta, lower, upper, levels=None):
     projectors = level_projectors(J, levels)
     stationary = gradient_small(J, e, levels, projectors, sigma_max) & \
         ~probe_improves(error_of, J, e, theta, levels, sigma_max, lower, upper)
-    saddle = saddle_of_levels(error_of, theta, levels, projectors, pinned, sigma_max)
-    return jnp.where(stationary, jnp.where(saddle, SADDLE, MINIMUM), CUT_SHORT)
+    at_saddle = saddle(error_of, theta, levels[0], pinned, sigma_max)
+    return jnp.where(stationary, jnp.where(at_saddle, SADDLE, MINIMUM), CUT_SHORT)
 
 
 STALL_BLOCKS = (8, 1024)  # rows per call: a solve's, a batch's
