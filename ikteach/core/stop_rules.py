@@ -198,10 +198,10 @@ def _stall_kinds(task, arm, targets, thetas, lower, upper, levels):
 
 
 def priority_levels(method, task, rows):
-    """The error's row indices per priority level (static tuples), level 0 first: the
-    method's levels for a prioritised solve (its rest pose is no level of ||e||), else one."""
+    """The error's row indices per priority level (static tuples), level 0 first, for a
+    prioritised solve (its rest pose is no level of ||e||); None (one level) otherwise."""
     if not isinstance(method, PriorityMethod):
-        return (tuple(range(rows)),)
+        return None
     return tuple(tuple(int(i) for i in r)
                  for r in method.rows_by_level(rows, block_size(task, rows)))
 
@@ -228,8 +228,7 @@ def why_stalled(method, task, arm, targets, thetas, stalled, settings):
         return kinds
     inner = method.inner if isinstance(method, LimitedMethod) else method
     targets, thetas = np.asarray(targets), np.asarray(thetas)
-    n_rows = jax.eval_shape(lambda q: task.error(arm, targets[0], q), thetas[0]).shape[0]
-    levels = priority_levels(inner, task, n_rows)
+    levels = priority_levels(inner, task, np.shape(task.error(arm, targets[0], thetas[0]))[0])
     block = STALL_BLOCKS[0] if rows.size <= STALL_BLOCKS[0] else STALL_BLOCKS[1]
     padded = np.concatenate([rows, np.repeat(rows[-1:], -rows.size % block)])
     n = np.shape(thetas)[-1]
