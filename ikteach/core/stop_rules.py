@@ -20,8 +20,8 @@ above SLOW_PROGRESS the status is "slow" instead of "stalled".
 A step can also be small for reasons that say nothing about reach; stall_kind looks at the
 theta where the solve stopped and tells four cases apart. A solve with priority levels has one
 error block e_k per level (level 0 first; a rest pose is not one: it is not part of ||e||); a
-plain solve has one level, e itself. Two tests, each in the problem's own scale (sigma_max, the
-largest singular value of J, turns a length into the error's units):
+plain solve has one level, e itself. Two tests, both scale-free (sigma_max, J's largest
+singular value, sets the scale of the gradient and of the probe's damping):
 
   projected gradient  g_k = N_<k J_k^T e_k, the direction that lowers 1/2 ||e_k||^2 without
               touching the levels before it (N_<k: the null space of their Jacobians; N = I for
@@ -170,7 +170,8 @@ def saddle(error_of, theta, rows, pinned, sigma_max):
 
 
 def stall_kind(task, arm, target, theta, lower, upper, levels=None):
-    """Why a solve stalled at theta: MINIMUM (out of reach), SADDLE or CUT_SHORT (module doc).
+    """Why a solve stalled at theta: MINIMUM (out of reach), SADDLE or CUT_SHORT (module doc;
+    why_stalled turns CUT_SHORT into FIXED_POINT for FABRIK and CCD).
 
     levels: the error's row indices per priority level, level 0 first (a tuple of tuples;
     None: one level, the whole error - a plain solve)."""
