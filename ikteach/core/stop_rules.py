@@ -145,19 +145,23 @@ def lexicographic_gain(before, after, scale):
     return jnp.any((change > IMPROVABLE) & (safe_so_far > 0))
 
 
+def probe_steps(J, e, levels, sigma_max):
+    """The probe's trial steps, one row each: the light priority steps (one per damping in
+    LIGHT_DAMPINGS), capped at PROBE_MAX_TURN, at each of PROBE_FRACTIONS of their length."""
+    parts = [(J[jnp.asarray(r)], e[jnp.asarray(r)]) for r in levels]
+    light = lambda lam: cap_step(multilevel_step(parts, lam), PROBE_MAX_TURN)
+    steps = jax.vmap(light)(jnp.asarray(LIGHT_DAMPINGS) * sigma_max)
+    return (jnp.asarray(PROBE_FRACTIONS)[:, None, None] * steps[None]).reshape(-1, J.shape[1])
+
+
 def probe_improves(error_of, J, e, theta, levels, sigma_max, lower, upper):
     """Would a lighter step still lower ||e||? (module doc: the probe). J's pinned columns are
     zeroed by the caller, so the probe steps leave those joints where they are."""
     before = level_norms(e, levels)
     scale = jnp.where(jnp.linalg.norm(e) > 0, jnp.linalg.norm(e), 1.0)
-    parts = [(J[jnp.asarray(r)], e[jnp.asarray(r)]) for r in levels]
-    gains = []
-    for fraction in LIGHT_DAMPINGS:
-        delta = cap_step(multilevel_step(parts, fraction * sigma_max), PROBE_MAX_TURN)
-        for t in PROBE_FRACTIONS:
-            after = level_norms(error_of(jnp.clip(theta + t * delta, lower, upper)), levels)
-            gains.append(lexicographic_gain(before, after, scale))
-    return jnp.any(jnp.stack(gains))
+    after = jax.vmap(lambda d: level_norms(error_of(jnp.clip(theta + d, lower, upper)), levels))(
+        probe_steps(J, e, levels, sigma_max))
+    return jnp.any(jax.vmap(lambda a: lexicographic_gain(before, a, scale))(after))
 
 
 def saddle(error_of, theta, rows, pinned, sigma_max):
