@@ -17,7 +17,6 @@ from ikteach.core.levels import rest_gain_bound
 from ikteach.core.tasks import task_for
 
 UR5_GOAL = np.array([0.3, -1.0, 1.2, 0.4, 0.8, -0.5])
-NO_LIMITS = types.SimpleNamespace(lower=-np.inf, upper=np.inf, max_step=np.inf)
 
 
 def scaled_ur5(scale):
@@ -141,6 +140,8 @@ def test_priorities_and_the_rest_pose_say_singular_like_plain_solves(kw):
 FABRIK_ARM = ik.serial_chain([[0.62, -0.78, 0.13], [-0.75, -0.6, -0.28], [-0.91, -0.1, -0.39]],
                              [[0.99, 0.07, -0.11], [-0.22, -0.52, -0.82], [-0.59, 0.72, -0.36]])
 FABRIK_TARGET = np.asarray(ik.fk(FABRIK_ARM, [0.78, -0.83, -1.99]))
+NO_LIMITS = types.SimpleNamespace(tol=float(ik.reach(FABRIK_ARM)) / 3000, lower=-np.inf,
+                                  upper=np.inf, max_step=np.inf)  # the solve's defaults
 
 
 def test_fabrik_on_a_hinge_chain_stops_at_its_own_fixed_point():

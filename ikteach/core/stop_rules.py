@@ -31,7 +31,9 @@ singular value, sets the scale of the gradient and of the probe's damping):
               (ik.multilevel_step; DLS for one level) with damping lambda = f sigma_max,
               f in LIGHT_DAMPINGS, each turn capped at PROBE_MAX_TURN radians and taken at
               PROBE_FRACTIONS of its length. It improves when some level's ||e_k|| falls by
-              more than IMPROVABLE ||e|| while no level before it grows by as much.
+              more than IMPROVABLE ||e|| and by more than tol (a gain below the accuracy asked
+              for changes nothing the solve can tell) while no level before it grows by more
+              than IMPROVABLE ||e||.
 
   MINIMUM      "stalled": g small and no probe improves, and the Hessian H of 1/2 ||e_0||^2
                (level 0) has no clearly negative eigenvalue: a minimum of ||e|| - the
@@ -41,8 +43,9 @@ singular value, sets the scale of the gradient and of the probe's damping):
                direction: a saddle, e.g. a straight arm whose target lies on its own line.
                Reachable; a nudge of the start gets the solve going;
   CUT_SHORT    "damped": g is not small or a lighter step would still lower ||e||: the
-               method's steps, not the target, stopped the solve (a large damping lambda,
-               max_step or clamp for this arm's size, or J's weak direction). Not out of reach;
+               method's steps, not the target, stopped the solve short of a minimum (a large
+               damping lambda, max_step or clamp for this arm's size, or J's weak direction).
+               Whether the target is in reach is open: solve again with less damping;
   FIXED_POINT  "fixed_point": as CUT_SHORT, but for a method that is not a Jacobian step
                (FABRIK, CCD) run without max_step: its own update has a fixed point there
                (FABRIK's hinge recovery on a spatial chain, say). Not out of reach; a Jacobian
@@ -137,12 +140,12 @@ def gradient_small(J, e, levels, projectors, sigma_max):
     return jnp.all(jnp.stack(norms) <= bound)
 
 
-def lexicographic_gain(before, after, scale):
+def lexicographic_gain(before, after, scale, tol):
     """Does `after` improve on `before` level by level: some level falls by more than
-    IMPROVABLE scale while none before it rises by as much?"""
-    change = (before - after) / scale
-    safe_so_far = jnp.cumprod(jnp.concatenate([jnp.ones(1), (change > -IMPROVABLE)[:-1]]))
-    return jnp.any((change > IMPROVABLE) & (safe_so_far > 0))
+    IMPROVABLE scale and more than tol, while none before it rises by more than IMPROVABLE scale?"""
+    fall = before - after
+    safe_so_far = jnp.cumprod(jnp.concatenate([jnp.ones(1), (fall > -IMPROVABLE * scale)[:-1]]))
+    return jnp.any((fall > jnp.maximum(IMPROVABLE * scale, tol)) & (safe_so_far > 0))
 
 
 def probe_steps(J, e, levels, sigma_max):
@@ -154,14 +157,14 @@ def probe_steps(J, e, levels, sigma_max):
     return (jnp.asarray(PROBE_FRACTIONS)[:, None, None] * steps[None]).reshape(-1, J.shape[1])
 
 
-def probe_improves(error_of, J, e, theta, levels, sigma_max, lower, upper):
+def probe_improves(error_of, J, e, theta, levels, sigma_max, lower, upper, tol):
     """Would a lighter step still lower ||e||? (module doc: the probe). J's pinned columns are
     zeroed by the caller, so the probe steps leave those joints where they are."""
     before = level_norms(e, levels)
     scale = jnp.where(jnp.linalg.norm(e) > 0, jnp.linalg.norm(e), 1.0)
     after = jax.vmap(lambda d: level_norms(error_of(jnp.clip(theta + d, lower, upper)), levels))(
         probe_steps(J, e, levels, sigma_max))
-    return jnp.any(jax.vmap(lambda a: lexicographic_gain(before, a, scale))(after))
+    return jnp.any(jax.vmap(lambda a: lexicographic_gain(before, a, scale, tol))(after))
 
 
 def saddle(error_of, theta, rows, pinned, sigma_max):
@@ -173,12 +176,13 @@ def saddle(error_of, theta, rows, pinned, sigma_max):
     return jnp.linalg.eigvalsh(H)[0] < -CURVATURE_FRACTION * sigma_max**2
 
 
-def stall_kind(task, arm, target, theta, lower, upper, levels=None):
+def stall_kind(task, arm, target, theta, lower, upper, levels=None, tol=0.0):
     """Why a solve stalled at theta: MINIMUM (out of reach), SADDLE or CUT_SHORT (module doc;
     why_stalled turns CUT_SHORT into FIXED_POINT for FABRIK and CCD).
 
     levels: the error's row indices per priority level, level 0 first (a tuple of tuples;
-    None: one level, the whole error - a plain solve)."""
+    None: one level, the whole error - a plain solve). tol: the solve's tolerance (a probe
+    must gain more than tol to count)."""
     error_of = lambda q: task.error(arm, target, q)
     e = error_of(theta)
     levels = (tuple(range(e.shape[0])),) if levels is None else levels
@@ -189,7 +193,7 @@ def stall_kind(task, arm, target, theta, lower, upper, levels=None):
     sigma_max = jnp.linalg.norm(J, 2)
     projectors = level_projectors(J, levels)
     stationary = gradient_small(J, e, levels, projectors, sigma_max) & \
-        ~probe_improves(error_of, J, e, theta, levels, sigma_max, lower, upper)
+        ~probe_improves(error_of, J, e, theta, levels, sigma_max, lower, upper, tol)
     at_saddle = saddle(error_of, theta, levels[0], pinned, sigma_max)
     return jnp.where(stationary, jnp.where(at_saddle, SADDLE, MINIMUM), CUT_SHORT)
 
@@ -198,8 +202,8 @@ STALL_BLOCKS = (8, 1024)  # rows per call: a solve's, a batch's
 
 
 @partial(runtime_jit.jit, static_argnames=("task", "levels"))
-def _stall_kinds(task, arm, targets, thetas, lower, upper, levels):
-    return jax.vmap(lambda t, q: stall_kind(task, arm, t, q, lower, upper, levels))(targets, thetas)
+def _stall_kinds(task, arm, targets, thetas, lower, upper, levels, tol):
+    return jax.vmap(lambda t, q: stall_kind(task, arm, t, q, lower, upper, levels, tol))(targets, thetas)
 
 
 def priority_levels(method, task, rows):
@@ -226,7 +230,7 @@ def why_stalled(method, task, arm, targets, thetas, stalled, settings):
 
     The loop calls it once, after the loop: targets (B, ...) and thetas (B, n) where each
     row stopped, stalled (B,) True where the row ended STALLED, settings the solve's
-    (lower, upper, max_step); KIND_STATUS[kind] is the status each stalled row reports."""
+    (tol, lower, upper, max_step); KIND_STATUS[kind] is the status each stalled row reports."""
     kinds = np.full(np.shape(stalled), MINIMUM)
     rows = np.flatnonzero(stalled)
     if rows.size == 0:
@@ -238,7 +242,7 @@ def why_stalled(method, task, arm, targets, thetas, stalled, settings):
     padded = np.concatenate([rows, np.repeat(rows[-1:], -rows.size % block)])
     n = np.shape(thetas)[-1]
     bounds = [np.broadcast_to(np.asarray(b, dtype=float), (n,)) for b in (settings.lower, settings.upper)]
-    found = [_stall_kinds(task, arm, targets[part], thetas[part], *bounds, levels)
+    found = [_stall_kinds(task, arm, targets[part], thetas[part], *bounds, levels, settings.tol)
              for part in padded.reshape(-1, block)]
     kinds[rows] = np.concatenate([np.asarray(f) for f in found])[: rows.size]
     if own_update(inner, settings):
