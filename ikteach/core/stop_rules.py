@@ -38,7 +38,8 @@ singular value, sets the scale of the gradient and of the probe's damping):
   MINIMUM      "stalled": g small and no probe improves, and the Hessian H of 1/2 ||e_0||^2
                (level 0) has no clearly negative eigenvalue: a minimum of ||e|| - the
                target is out of reach of this start (another start may reach it: a local
-               minimum looks the same from inside);
+               minimum looks the same from inside). "A minimum" as far as one light step can
+               tell: a long, flat valley that descends only after tens of steps reads as one;
   SADDLE       "singular": the same, but H < -CURVATURE_FRACTION sigma_max^2 along some
                direction: a saddle, e.g. a straight arm whose target lies on its own line.
                Reachable; a nudge of the start gets the solve going;
