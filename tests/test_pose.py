@@ -57,14 +57,17 @@ def test_fk_pose_matches_fk_and_is_a_rigid_transform():
 
 
 def test_orientation_rows_of_the_6xn_jacobian_drive_the_log_error():
-    """d/dtheta log(R_t R(theta)^T) = -J_angular at R = R_t (first-order check)."""
+    """d/dtheta log(R_t R(theta)^T) = -J_angular at R = R_t (first-order check); the task
+    weighs the orientation rows by the arm's reach L, in e and in J alike."""
     arm = ik.core.robots.iiwa14()
     theta = np.array([0.1, 0.5, -0.3, -1.0, 0.2, 0.7, -0.4])
     T = np.asarray(ik.fk_pose(arm, theta))
     task = ik.core.pose.PoseTask()
     J_err = jax.jacfwd(lambda q: task.error(arm, jnp.asarray(T), q))(jnp.asarray(theta))
-    np.testing.assert_allclose(np.asarray(J_err), -np.asarray(ik.jacobian(arm, theta, full=True)),
-                               atol=1e-10)
+    J = np.asarray(ik.jacobian(arm, theta, full=True))
+    weighed = np.vstack([J[:3], float(ik.reach(arm)) * J[3:]])
+    np.testing.assert_allclose(np.asarray(J_err), -weighed, atol=1e-10)
+    np.testing.assert_allclose(np.asarray(task.jacobian(arm, jnp.asarray(theta))), weighed, atol=1e-12)
 
 
 @pytest.mark.parametrize("arm_fn", [ik.core.robots.ur5, ik.core.robots.iiwa14])

@@ -102,7 +102,7 @@ def test_batch_gives_the_same_statuses_as_solve_on_the_queue_path():
 
 def test_new_statuses_are_appended():
     assert solve_module.STATUSES[:5] == ("running", "converged", "stalled", "max_iter", "diverged")
-    assert solve_module.STATUSES[5:] == ("slow", "singular", "damped")
+    assert solve_module.STATUSES[5:] == ("slow", "singular", "damped", "fixed_point")
 
 
 def test_dls_without_damping_at_a_singular_start_stops_diverged_never_nan():

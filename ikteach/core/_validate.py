@@ -94,3 +94,11 @@ def as_count(x, name, minimum=1):
     if x < minimum:
         raise ValueError(f"{name}: expected an integer >= {minimum}, got {x}")
     return int(x)
+
+
+def round_finite(x, decimals):
+    """x rounded to `decimals` places, for printing. np.round(x, d) multiplies by 10^d first,
+    so 1e305 prints as inf; a float64 beyond 2^52 is a whole number already and is kept."""
+    x = np.asarray(x, dtype=np.float64)
+    small = np.abs(x) < 1e15
+    return np.where(small, np.round(np.where(small, x, 0.0), decimals), x)

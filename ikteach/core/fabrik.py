@@ -16,15 +16,17 @@ from .ccd import as_point3, ccd_angle
 from .kinematics import joint_frames
 from .method import method
 
-EPS = 1e-12
+EPS = 1e-12  # relative: two points closer than EPS times the link length count as one
 
 
 def _toward(a, b, d):
-    """The point at distance d from a in the direction of b (along +x when b = a, so that
-    the link keeps its length even when two points coincide)."""
+    """The point at distance d from a in the direction of b (along +x when b and a are
+    closer than EPS d, so that the link keeps its length even when two points coincide;
+    relative to d, so an arm of 1e-13 works like one of 1)."""
     v = b - a
     n = jnp.linalg.norm(v)
-    unit = jnp.where(n > EPS, v / jnp.where(n > EPS, n, 1.0), jnp.array([1.0, 0.0, 0.0]))
+    apart = n > EPS * d
+    unit = jnp.where(apart, v / jnp.where(apart, n, 1.0), jnp.array([1.0, 0.0, 0.0]))
     return a + d * unit
 
 

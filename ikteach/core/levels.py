@@ -7,6 +7,12 @@ before it (ik.core.priority.multilevel_step), so e.g. feet (level 0) stay plante
 reaches as far as the feet allow. rest_pose adds one last level, e = gain (theta_rest - theta)
 with J = I: with the freedom that is still left, drift back towards a preferred pose.
 
+The rest level's step: the damped pseudoinverse of J N = N (singular values 1) is
+N / (1 + lambda^2), so each step moves theta by gain / (1 + lambda^2) of the way to rest_pose
+within the null space N. Above 1 + lambda^2 it overshoots; at 2 (1 + lambda^2) and beyond the
+overshoot grows every step and theta explodes. So rest_gain must lie below
+rest_gain_bound(lambda) = 2 (1 + lambda^2) (a ValueError otherwise); the default 0.1 is far below.
+
 The loop itself is unchanged: it stops "converged" when the whole error (every level,
 not the rest pose) is below tol, and "stalled" when the levels conflict and the step dies out.
 """
@@ -19,6 +25,22 @@ from .pose import PoseTask
 from .priority import multilevel_step
 
 DEFAULT_REST_GAIN = 0.1
+
+
+def rest_gain_bound(damping):
+    """The largest stable rest gain (exclusive): 2 (1 + lambda^2) (module doc)."""
+    return 2.0 * (1.0 + damping**2)
+
+
+def check_rest_gain(gain, damping):
+    """gain > 0 and below rest_gain_bound(damping), or a ValueError naming rest_gain."""
+    gain = as_number(gain, "rest_gain", minimum=0, strict=True)
+    bound = rest_gain_bound(damping)
+    if gain >= bound:
+        raise ValueError(f"rest_gain: expected a gain below 2 (1 + damping^2) = {bound:.4g} "
+                         f"(each step moves theta rest_gain / (1 + damping^2) of the way to "
+                         f"rest_pose; from 2 (1 + damping^2) on it overshoots more every step), got {gain:g}")
+    return gain
 
 
 def block_size(task, rows):
@@ -76,5 +98,6 @@ def with_priorities(method, problem, theta0, options):
             raise ValueError(f"rest_pose: expected shape {np.shape(theta0)} (one angle per "
                              f"joint), got shape {np.shape(rest_pose)}")
         rest_pose = jnp.asarray(rest_pose)
-        gain = DEFAULT_REST_GAIN if options.rest_gain is None else options.rest_gain
+        gain = check_rest_gain(DEFAULT_REST_GAIN if options.rest_gain is None
+                               else options.rest_gain, method.damping)
     return Priorities(levels, block, method.damping, rest_pose, gain)

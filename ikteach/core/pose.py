@@ -3,7 +3,14 @@
 A pose is a 4x4 homogeneous transform T = [[R, p], [0, 1]]. The pose error stacks the
 position error and the orientation error as an axis-angle vector:
 
-    e = [ beta_p (p_t - p(theta)) ;  beta_o log(R_t R(theta)^T) ]          (6,)
+    e = [ beta_p (p_t - p(theta)) ;  beta_o L log(R_t R(theta)^T) ]          (6,)
+
+L is the arm's reach (the sum of its link lengths, ik.reach): an angle times a length is a
+length, so every entry of e is a length and the solve's lengths (tol = L / 3000, damping
+lambda = L / 6, stall_tol = tol / 100) mean the same at every unit. Scale the arm by s and
+e, J and those lengths all scale by s: metres and millimetres give the same steps. With
+the default weights, "converged" (||e|| < tol) means a position error below tol and an
+orientation error below tol / L radians (1/3000 rad with the default tol) - both at once.
 
 log(R_t R^T) is the rotation vector omega with R_t = exp([omega]x) R: the small rotation
 that takes the current hand to the target, in world coordinates. Its derivative at
@@ -16,7 +23,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ._validate import as_number
+from ._validate import as_array, as_number
 from .chain import Chain, reach
 from .jacobian import jacobian
 from .kinematics import joint_frames, skew
@@ -98,7 +105,8 @@ def orientation_error(R_target, R):
 class PoseTask:
     """Reach a 4x4 pose with a spatial chain.
 
-    e = [beta_p (p_t - p); beta_o log(R_t R^T)],  J = diag(beta_p I, beta_o I) [z_i x (p_e - p_i); z_i].
+    e = [beta_p (p_t - p); beta_o L log(R_t R^T)],  J = diag(beta_p I, beta_o L I) [z_i x (p_e - p_i); z_i],
+    L the arm's reach (module doc: every row is then a length).
     The weights are the task's data (a pytree leaf each): traced, so new weights reuse the
     compiled loop (ik.solve(..., weights=(beta_p, beta_o)) makes a new task, not a program).
     """
@@ -121,11 +129,15 @@ class PoseTask:
         positions, _, R = joint_frames(arm, theta)
         e_p = target[:3, 3] - positions[-1]
         e_o = orientation_error(target[:3, :3], R)
-        return jnp.concatenate([self.position_weight * e_p, self.orientation_weight * e_o])
+        return jnp.concatenate([self.position_weight * e_p, self.orientation_scale(arm) * e_o])
 
     def jacobian(self, arm, theta):
         J = jacobian(arm, theta, full=True)
-        return jnp.vstack([self.position_weight * J[:3], self.orientation_weight * J[3:]])
+        return jnp.vstack([self.position_weight * J[:3], self.orientation_scale(arm) * J[3:]])
+
+    def orientation_scale(self, arm):
+        """beta_o L: radians of orientation error to the length they count as in e."""
+        return self.orientation_weight * arm_length(arm)
 
     def length_scale(self, arm):
         return float(reach(arm))
@@ -146,6 +158,11 @@ class PoseTask:
 
 jax.tree_util.register_dataclass(PoseTask, data_fields=["position_weight", "orientation_weight"],
                                  meta_fields=[])
+
+
+def arm_length(arm):
+    """The arm's reach L = sum_i |offsets[i]| (traceable: ik.reach for the loop's arm)."""
+    return jnp.sum(jnp.linalg.norm(jnp.asarray(arm.offsets), axis=1))
 
 
 RIGID_TOL = 1e-6  # largest |R^T R - I| entry and |bottom row - [0, 0, 0, 1]| accepted
@@ -176,7 +193,11 @@ def check_pose(T, name="target"):
 
 
 def pose_errors(arm, theta, target):
-    """(position error |p_t - p|, orientation error angle in radians) of theta for a 4x4 target."""
+    """(position error |p_t - p|, orientation error angle in radians) of theta for a 4x4 target.
+
+    target must be a rigid transform (check_pose: a ValueError naming target otherwise)."""
+    target = as_array(target, "target", shape=(4, 4))
+    check_pose(target, "target")
     T = fk_pose(arm, theta)
     target = jnp.asarray(target)
     e_p = jnp.linalg.norm(target[:3, 3] - T[:3, 3])
@@ -185,7 +206,12 @@ def pose_errors(arm, theta, target):
 
 
 def make_pose(R, p):
-    """The 4x4 transform [[R, p], [0, 1]] from a rotation matrix and a position."""
+    """The 4x4 transform [[R, p], [0, 1]] from a rotation matrix R (3, 3) and a position p (3,).
+
+    Numbers given (not traced) are checked: a ValueError naming R or p for a wrong shape or
+    non-finite entries. (Whether R is a rotation is ik.solve's check: check_pose.)"""
+    if not any(isinstance(x, jax.core.Tracer) for x in (R, p)):
+        R, p = as_array(R, "R", shape=(3, 3)), as_array(p, "p", shape=(3,))
     top = jnp.hstack([jnp.asarray(R, dtype=float), jnp.asarray(p, dtype=float)[:, None]])
     return jnp.vstack([top, jnp.array([[0.0, 0.0, 0.0, 1.0]])])
 

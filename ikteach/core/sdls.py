@@ -30,7 +30,15 @@ from .method import JacobianMethod, method
 from .safeguards import cap_step
 
 GAMMA_MAX = np.pi / 4   # Buss & Kim 2005, section 4
-NEAR_ZERO = 1e-10       # singular values below this are skipped (as in Buss's demo code)
+# Singular values below NEAR_ZERO sigma_max are skipped. Buss's demo code skips those below
+# 1e-10 absolute, for arms of unit size; relative to sigma_max (a length, like J) the same
+# directions are skipped at every scale: an arm of 1e-11 gets its steps, as one of 1 does.
+NEAR_ZERO = 1e-10
+
+
+def kept(sigma):
+    """The singular directions SDLS uses: sigma_i > NEAR_ZERO sigma_max (scale-free)."""
+    return sigma > NEAR_ZERO * jnp.max(sigma, initial=0.0)
 
 
 def block_norms(A, block):
@@ -43,7 +51,7 @@ def sdls_gamma(U, sigma, Vt, J, gamma_max, block):
     """gamma_i = min(1, N_i / M_i) gamma_max for every singular direction i (see module doc)."""
     N = block_norms(U, block).sum(axis=0)
     column_size = block_norms(J, block).sum(axis=0)              # sum_k ||J_{k,l}||
-    safe_sigma = jnp.where(sigma > NEAR_ZERO, sigma, 1.0)
+    safe_sigma = jnp.where(kept(sigma), sigma, 1.0)
     M = (jnp.abs(Vt) @ column_size) / safe_sigma
     ratio = jnp.where(M > 0, N / jnp.where(M > 0, M, 1.0), 1.0)
     return gamma_max * jnp.minimum(1.0, ratio)
@@ -65,7 +73,7 @@ def sdls_step(J, e, gamma_max=GAMMA_MAX, block=None, soft=False):
     block = J.shape[0] if block is None else block
     U, sigma, Vt = jnp.linalg.svd(J, full_matrices=False)
     gamma = sdls_gamma(U, sigma, Vt, J, gamma_max, block)
-    keep = sigma > NEAR_ZERO
+    keep = kept(sigma)
     coeff = jnp.where(keep, (U.T @ e) / jnp.where(keep, sigma, 1.0), 0.0)
     if soft:
         total = jax.vmap(soft_rescale)(coeff[:, None] * Vt, gamma).sum(axis=0)

@@ -9,10 +9,10 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ._validate import as_array
+from ._validate import as_array, round_finite
 from .joint_limits import with_limits
 from .levels import with_priorities
-from .loop import CONVERGED, DAMPED, RUNNING, SINGULAR, STALLED, STATUSES, iterate, start
+from .loop import CONVERGED, RUNNING, STALLED, STATUSES, iterate, start
 from .methods import as_method, check_method_target, traceable
 from .options import Options
 from .problem import Problem
@@ -53,7 +53,7 @@ class Result:
         return self.status == "converged"
 
     def __repr__(self):
-        theta = [float(f"{x:.4g}") if abs(x) >= 1e4 else round(float(x), 4) for x in self.theta]
+        theta = round_finite(self.theta, 4).tolist()
         return (f"Result(status={self.status!r}, iterations={self.iterations}, "
                 f"error={self.error:.3g}, theta={theta})")
 
@@ -102,15 +102,21 @@ def prepare(arm, target, theta0, method, options, method_parameters, rows=None):
 
 
 def explain_stalls(problem, method, options, targets, thetas, status):
-    """status with each STALLED row looked at where it stopped (stop_rules.why_stalled):
-    a saddle of ||e|| becomes SINGULAR, a stop while J still sees the error DAMPED."""
+    """status with each STALLED row looked at where it stopped (stop_rules.why_stalled): a
+    saddle of ||e|| becomes SINGULAR, a stop short of a minimum DAMPED, and FABRIK's or CCD's
+    own fixed point FIXED_POINT; priority levels are judged level by level."""
     status = np.array(status)
-    kinds = stop_rules.why_stalled(problem.task, problem.arm, targets, thetas, status == STALLED,
-                                   *options.joint_limits,
-                                   prioritised=hasattr(method, "levels")
-                                   or hasattr(getattr(method, "inner", None), "levels"))
-    return np.select([kinds == stop_rules.SADDLE, kinds == stop_rules.CUT_SHORT],
-                     [SINGULAR, DAMPED], status)
+    stalled = status == STALLED
+    inner = getattr(method, "inner", method)  # within joint limits: the method inside
+    levels = None
+    if hasattr(inner, "rows_by_level") and stalled.any():
+        rows = np.shape(problem.error(jnp.asarray(np.asarray(thetas)[0])))[0]
+        levels = tuple(tuple(int(i) for i in r) for r in inner.rows_by_level(rows))
+    own_update = not method.uses_jacobian and not np.isfinite(options.max_step)
+    kinds = stop_rules.why_stalled(problem.task, problem.arm, targets, thetas, stalled, options,
+                                   levels, own_update)
+    named = np.array([STATUSES.index(name) for name in stop_rules.KIND_STATUS])
+    return np.where(stalled, named[kinds], status)
 
 
 def solve(arm, target, theta0, method="dls", options=None, *, damping=None, rcond=None,

@@ -9,9 +9,11 @@ from ..core.sweeps import (Grid, SweepMap, Tracking, end_path, reach_radii, sigm
 
 # one colour per status of ik.STATUSES (a status without one would be drawn white, like no target)
 STATUS_COLORS = {"converged": "#55a868", "stalled": "#dd8452", "max_iter": "#c44e52",
-                 "diverged": "#222222", "slow": "#8172b3", "singular": "#4c72b0", "damped": "#937860"}
+                 "diverged": "#222222", "slow": "#8172b3", "singular": "#4c72b0", "damped": "#937860",
+                 "fixed_point": "#da8bc3"}
 STATUS_COLOR_NAMES = {"converged": "green", "stalled": "orange", "max_iter": "red",
-                      "diverged": "black", "slow": "purple", "singular": "blue", "damped": "brown"}
+                      "diverged": "black", "slow": "purple", "singular": "blue", "damped": "brown",
+                      "fixed_point": "pink"}
 
 
 def boundary(mask, grid):
