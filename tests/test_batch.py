@@ -28,7 +28,7 @@ def test_batch_takes_one_start_per_target_and_counts_statuses():
     assert len(res) == 2
     assert list(res.status) == ["converged", "stalled"]
     assert res.counts() == {"converged": 1, "stalled": 1, "max_iter": 0, "diverged": 0, "slow": 0,
-                            "singular": 0, "damped": 0}
+                            "singular": 0, "damped": 0, "fixed_point": 0}
 
 
 def test_batch_accepts_a_jax_step_function():

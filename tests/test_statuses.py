@@ -150,8 +150,8 @@ def test_fabrik_on_a_hinge_chain_stops_at_its_own_fixed_point():
     res = ik.solve(FABRIK_ARM, FABRIK_TARGET, np.zeros(3), method="fabrik")
     assert res.status != "damped" and res.error > 1.0
     task = task_for(FABRIK_ARM, (3,))
-    kinds = stop_rules.why_stalled(ik.core.methods.METHODS["fabrik"], task, FABRIK_ARM,
-                                   FABRIK_TARGET[None], res.theta[None], np.array([True]), NO_LIMITS)
+    kinds = stop_rules.why_stalled(task, FABRIK_ARM, FABRIK_TARGET[None], res.theta[None],
+                                   np.array([True]), ik.Options(tol=NO_LIMITS.tol).resolved(1.0, 3), own_update=True)
     assert stop_rules.KIND_STATUS[int(kinds[0])] == "fixed_point"
     assert ik.solve(FABRIK_ARM, FABRIK_TARGET, res.theta, method="pinv").converged
 

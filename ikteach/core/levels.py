@@ -20,6 +20,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ._validate import as_number
 from .method import JacobianMethod, method
 from .pose import PoseTask
 from .priority import multilevel_step
