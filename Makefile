@@ -48,6 +48,8 @@ PYTEST_ARGS = -n 2 --dist loadfile tests $(NOTEBOOKS) --nbval --nbval-sanitize-w
 # the versions of package-lock.json. `make test` builds the book, so it needs them too.
 NODE_STAMP := node_modules/.package-lock.json
 $(NODE_STAMP): package.json package-lock.json
+	@command -v npm >/dev/null || { echo "npm not found: installing Debian's nodejs and npm"; \
+	  $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq nodejs npm; }
 	npm ci --no-audit --no-fund --loglevel=error
 	@touch $(NODE_STAMP)
 node_modules: $(NODE_STAMP)
