@@ -74,15 +74,10 @@ def exercise_number(path, book):
 
 def _run_cells(book, sandbox, timeout):
     """Run the notebook's cells in the sandbox; (error lines, notes) from the job's report."""
+    from .grading.extract import code_cells
     from .grading.servers import server_for
 
-    cells = []
-    for index, cell in enumerate(book["cells"]):
-        if isinstance(cell, dict) and cell.get("cell_type") == "code":
-            source = cell.get("source", "")
-            cells.append((index + 1, "".join(map(str, source)) if isinstance(source, list)
-                          else str(source)))
-    job = server_for(sandbox).job("cells", timeout, {"cells": cells})
+    job = server_for(sandbox).job("cells", timeout, {"cells": code_cells(book)})
     report, ended = b"", None
     try:
         deadline = time.monotonic() + timeout + GRACE  # the server kills it at `timeout`
