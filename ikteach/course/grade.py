@@ -301,6 +301,9 @@ def main(argv=None):
                         help="address space of one student process (default %(default)s)")
     parser.add_argument("--cpu-s", type=int, default=Limits.cpu_seconds,
                         help="CPU seconds of one student process (default %(default)s)")
+    parser.add_argument("--tmpfs-mb", type=int, default=Limits.tmpfs_mb,
+                        help="size of each of a student's /tmp, /dev/shm and working folder, "
+                             "all in memory (default %(default)s)")
     parser.add_argument("--no-bwrap", action="store_true",
                         help="do not use bubblewrap even where it works (then only "
                              f"{OVERRIDE} grades)")
@@ -316,7 +319,7 @@ def main(argv=None):
         return 0
     if not args.out:
         parser.error("--out is required (the CSV to write)")
-    limits = Limits(cpu_seconds=args.cpu_s, memory_mb=args.memory_mb)
+    limits = Limits(cpu_seconds=args.cpu_s, memory_mb=args.memory_mb, tmpfs_mb=args.tmpfs_mb)
     try:
         rows = grade_all(args.submissions, args.out, args.feedback, args.timeout, args.jobs,
                          args.grade_timeout, limits=limits,
