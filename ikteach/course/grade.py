@@ -1,7 +1,8 @@
 """Grade the students' exercise notebooks.
 
     python -m ikteach.course.grade SUBMISSIONS_DIR --out grades.csv [--feedback DIR] [--timeout S]
-                            [--grade-timeout S] [--jobs N] [--memory-mb M] [--no-sandbox]
+                            [--grade-timeout S] [--jobs N] [--memory-mb M] [--tmpfs-mb T]
+                            [--no-sandbox]
     python -m ikteach.course.grade --gradescope OUT.zip      (a Gradescope autograder bundle)
 
 SUBMISSIONS_DIR holds one folder per student (the folder name is the student), each with that
@@ -298,7 +299,8 @@ def main(argv=None):
                         help="seconds allowed for one notebook's checks (default %(default)s)")
     parser.add_argument("--jobs", type=int, default=1, help="notebooks graded at once")
     parser.add_argument("--memory-mb", type=int, default=Limits.memory_mb,
-                        help="address space of one student process (default %(default)s)")
+                        help="address space of one student process, and the memory of one "
+                             "sandbox where a memory cgroup can be made (default %(default)s)")
     parser.add_argument("--cpu-s", type=int, default=Limits.cpu_seconds,
                         help="CPU seconds of one student process (default %(default)s)")
     parser.add_argument("--tmpfs-mb", type=int, default=Limits.tmpfs_mb,

@@ -202,4 +202,7 @@ def judge(seen, escaped, hidden):
                  "notebook in a fresh child")
     if seen.get("userns_blocked"):
         lines.append("cannot create user namespaces (so it cannot regain capabilities)")
+    if seen.get("new_session") is False:
+        lines.append("cannot start a session of its own (so a job's processes share one "
+                     "scheduler group) or use the kernel's keyrings (seccomp)")
     return lines

@@ -6,10 +6,17 @@ run sees a read-only whitelist of the machine (system libraries, a few files of 
 Python the grader runs on, ikteach's package without its checker) and its own working folder;
 /tmp private; no network; own PID, IPC and UTS namespaces; its own user namespace as an
 unprivileged uid with no capabilities, also when the grader runs as root.
+What a run writes lives in memory, size-limited (tmpfs: /tmp, /dev/shm, its working folder;
+/dev read-only); POSIX message queues show in /dev/mqueue, so the fork server removes a job's;
+seccomp refuses new sessions (one scheduler autogroup per sandbox, not one per busy child) and
+the kernel keyrings (not namespaced).
 Always: own HOME, bare environment (BLAS kernel variables passed through, so that the student's
 numbers come from the same kernels as the grader's), resource limits (CPU time, address space,
-file size, no core files), its own process group (ended as a whole, from outside); a cap on
-processes where the cgroup v1 `pids` controller is writable, else RLIMIT_NPROC (not for root).
+file size, no core files), its own process group (ended as a whole, from outside), the OOM
+killer's first choice (oom_score_adj 1000: the grader survives a student's memory); where this
+process may make cgroups (v1 pids/memory/cpu, or v2), one per sandbox: processes (pids.max),
+memory of its processes and files together, an equal CPU share; else RLIMIT_NPROC (not for
+root).
 Student code runs in jobs of a fork server started in the sandbox (servers.py, forkserver.py):
 one bubblewrap per server, a fresh child per notebook run or checks' worker, everything of a job
 killed and removed when it ends. `Sandbox.verify()` runs a probe as such a job and `report()`
