@@ -248,8 +248,10 @@ class Sandbox:
                 continue
             made.append(path)
             for name, field in CGROUP_LIMITS.items():
-                if (path / name).exists():
+                try:
                     (path / name).write_text(str(self.limits.cgroup_value(field)))
+                except OSError:  # not this cgroup version's file, or not writable
+                    pass
         return made
 
     def command(self, argv, work, cgroups, pid1=False, seccomp=None):
