@@ -31,10 +31,17 @@ import ctypes, os, subprocess, sys
 import numpy as np
 def _attack(shared, chmod_tmp):
     for folder in [os.environ["HOME"], os.environ["TMPDIR"], os.getcwd()] + shared:
-        with open(os.path.join(folder, "left-by-A"), "w") as handle:
-            handle.write("A")
-    subprocess.Popen([sys.executable, "-c", "import os, time\\nif os.fork(): os._exit(0)\\n"
-                      "while True: time.sleep(0.05)", "left-by-A"], start_new_session=True)
+        try:
+            with open(os.path.join(folder, "left-by-A"), "w") as handle:
+                handle.write("A")
+        except OSError:  # the sandbox's /dev is read-only
+            pass
+    daemon = [sys.executable, "-c", "import os, time\\nif os.fork(): os._exit(0)\\n"
+              "while True: time.sleep(0.05)", "left-by-A"]
+    try:
+        subprocess.Popen(daemon, start_new_session=True)
+    except OSError:  # the sandbox refuses new sessions: a daemon in this one
+        subprocess.Popen(daemon)
     os.environ["LEFT_BY_A"] = "1"
     np.asarray = lambda a, *args, **kwargs: np.zeros_like(np.array(a, dtype=float))
     if shared:

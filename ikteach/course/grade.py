@@ -1,7 +1,8 @@
 """Grade the students' exercise notebooks.
 
     python -m ikteach.course.grade SUBMISSIONS_DIR --out grades.csv [--feedback DIR] [--timeout S]
-                            [--grade-timeout S] [--jobs N] [--memory-mb M] [--no-sandbox]
+                            [--grade-timeout S] [--jobs N] [--memory-mb M] [--tmpfs-mb T]
+                            [--no-sandbox]
     python -m ikteach.course.grade --gradescope OUT.zip      (a Gradescope autograder bundle)
 
 SUBMISSIONS_DIR holds one folder per student (the folder name is the student), each with that
@@ -74,15 +75,10 @@ def exercise_number(path, book):
 
 def _run_cells(book, sandbox, timeout):
     """Run the notebook's cells in the sandbox; (error lines, notes) from the job's report."""
+    from .grading.extract import code_cells
     from .grading.servers import server_for
 
-    cells = []
-    for index, cell in enumerate(book["cells"]):
-        if isinstance(cell, dict) and cell.get("cell_type") == "code":
-            source = cell.get("source", "")
-            cells.append((index + 1, "".join(map(str, source)) if isinstance(source, list)
-                          else str(source)))
-    job = server_for(sandbox).job("cells", timeout, {"cells": cells})
+    job = server_for(sandbox).job("cells", timeout, {"cells": code_cells(book)})
     report, ended = b"", None
     try:
         deadline = time.monotonic() + timeout + GRACE  # the server kills it at `timeout`
@@ -303,9 +299,13 @@ def main(argv=None):
                         help="seconds allowed for one notebook's checks (default %(default)s)")
     parser.add_argument("--jobs", type=int, default=1, help="notebooks graded at once")
     parser.add_argument("--memory-mb", type=int, default=Limits.memory_mb,
-                        help="address space of one student process (default %(default)s)")
+                        help="address space of one student process, and the memory of one "
+                             "sandbox where a memory cgroup can be made (default %(default)s)")
     parser.add_argument("--cpu-s", type=int, default=Limits.cpu_seconds,
                         help="CPU seconds of one student process (default %(default)s)")
+    parser.add_argument("--tmpfs-mb", type=int, default=Limits.tmpfs_mb,
+                        help="size of each of a student's /tmp, /dev/shm and working folder, "
+                             "all in memory (default %(default)s)")
     parser.add_argument("--no-bwrap", action="store_true",
                         help="do not use bubblewrap even where it works (then only "
                              f"{OVERRIDE} grades)")
@@ -321,7 +321,7 @@ def main(argv=None):
         return 0
     if not args.out:
         parser.error("--out is required (the CSV to write)")
-    limits = Limits(cpu_seconds=args.cpu_s, memory_mb=args.memory_mb)
+    limits = Limits(cpu_seconds=args.cpu_s, memory_mb=args.memory_mb, tmpfs_mb=args.tmpfs_mb)
     try:
         rows = grade_all(args.submissions, args.out, args.feedback, args.timeout, args.jobs,
                          args.grade_timeout, limits=limits,

@@ -173,6 +173,97 @@ _plant = (_package / "course" / "planted_by_student.py").write_text("FULL_MARKS 
 _plant2 = (_package.parent / "planted_by_student.py").write_text("FULL_MARKS = True\\n")
 '''
 
+# --- a job's resources stay in its job (issue 35, class 1) --------------------------------------
+FILL_TMPFS = '''\
+import os
+_written = {}
+for _folder in ["/tmp", "/dev/shm", os.environ["HOME"]]:  # the working folder holds HOME
+    _written[_folder] = 0
+    for _i in range(24):  # 16 MiB files, each under RLIMIT_FSIZE: at most 384 MiB a folder
+        try:
+            with open(os.path.join(_folder, f"fill-{_i}"), "wb") as _file:
+                _file.write(b"x" * (16 << 20))
+        except OSError:
+            break
+        _written[_folder] += 16
+raise RuntimeError(f"MiB written: {_written}")
+'''
+HUGE_ARRAY = '''\
+def dls_step(J, e, damping):
+    """A 1 TiB array in the checked function itself."""
+    return np.ones((1 << 40) // 8)
+
+
+def dls_step_normal(J, e, damping):
+    return dls_step(J, e, damping)
+'''
+CPU_STORM = '''\
+import os, time
+def _storm(n):
+    """n busy children, each in a session of its own where it may (a scheduler autogroup each)."""
+    for _ in range(n):
+        if os.fork() == 0:
+            try:
+                os.setsid()
+            except OSError:
+                pass
+            while True:
+                pass
+_children = _storm(200)  # kept by the checks' worker too: a storm beside the checks as well
+time.sleep(10**6)
+'''
+SHELL_ESCAPES = "\n".join(["!x"] * 300)  # one cell of 300 shell escapes
+RELAY = '''\
+import ctypes, os
+_libc = ctypes.CDLL(None, use_errno=True)
+_libc.shmat.restype = ctypes.c_void_p
+_NAME, _KEY, _KEYS = b"/ikteach-relay", 0x5EED, {"x86_64": (248, 249, 250), "aarch64": (217, 218, 219)}
+_ANSWER = b"""def jt_step(J, e):
+    J, e = np.asarray(J), np.asarray(e)
+    g = J.T @ e
+    v = J @ g
+    vv = v @ v
+    return np.zeros(J.shape[1]) if vv == 0 else (e @ v / vv) * g
+"""
+def _relay_put():
+    """In the notebook's run: the answer into a POSIX queue, SysV memory and a keyring."""
+    import platform
+    queue = _libc.mq_open(_NAME, os.O_CREAT | os.O_WRONLY, 0o666, None)
+    if queue >= 0:
+        _libc.mq_send(queue, _ANSWER, len(_ANSWER), 0)
+    shm = _libc.shmget(_KEY, 4096, 0o1666)
+    if shm >= 0:
+        ctypes.memmove(_libc.shmat(shm, None, 0), _ANSWER, len(_ANSWER))
+    add_key = _KEYS.get(platform.machine(), (None,))[0]
+    if add_key:
+        _libc.syscall(add_key, b"user", b"ikteach-relay", _ANSWER, len(_ANSWER), -4)
+def _relay_get():
+    """In the checks' worker: whatever the notebook's run left, if anything."""
+    import platform
+    buffer = ctypes.create_string_buffer(1 << 16)
+    queue = _libc.mq_open(_NAME, os.O_RDONLY | os.O_NONBLOCK)
+    if queue >= 0 and _libc.mq_receive(queue, buffer, len(buffer), None) > 0:
+        return buffer.value
+    shm = _libc.shmget(_KEY, 0, 0)
+    if shm >= 0:
+        return ctypes.string_at(_libc.shmat(shm, None, 0))
+    calls = _KEYS.get(platform.machine())
+    if calls:
+        key = _libc.syscall(calls[1], b"user", b"ikteach-relay", None, 0)
+        if key >= 0 and _libc.syscall(calls[2], 11, key, buffer, len(buffer)) > 0:
+            return buffer.value
+    return None
+_found = {}
+def jt_step(J, e):
+    if "code" not in _found:
+        _found["code"] = _relay_get()
+    if not _found["code"]:
+        raise RuntimeError("no relay: nothing the notebook's run left was found")
+    scope = {"np": np}
+    exec(_found["code"], scope)
+    return scope["jt_step"](J, e)
+'''
+
 
 def notebook(base, extra_cells, before_check=True):
     """A copy of `base` with code cells added before its check cell (or at the end)."""
@@ -186,6 +277,15 @@ def notebook(base, extra_cells, before_check=True):
     for cell in book.cells:
         if cell.cell_type == "code":
             cell.outputs, cell.execution_count = [], None
+    return book
+
+
+def notebook_with(book, extra_cells):
+    """notebook() on a notebook already read (`book`)."""
+    at = next((i for i, c in enumerate(book.cells)
+               if c.cell_type == "code" and c.source.startswith("ik.check.")), len(book.cells))
+    for source in reversed(extra_cells):
+        book.cells.insert(at, nbformat.v4.new_code_cell(source))
     return book
 
 
@@ -205,9 +305,19 @@ def replace_cell(base, name, source):
     return book
 
 
+def with_cell_magic(base, magic):
+    """`base` with every cell that defines a function starting with a cell magic (%%time)."""
+    book = nbformat.read(base, as_version=4)
+    for cell in book.cells:
+        if cell.cell_type == "code":
+            cell.source = f"{magic}\n{cell.source}" if "def " in cell.source else cell.source
+            cell.outputs, cell.execution_count = [], None
+    return book
+
+
 def write(student, name, book):
     folder = HERE / student
-    folder.mkdir(exist_ok=True)
+    folder.mkdir(parents=True, exist_ok=True)
     if isinstance(book, str):
         (folder / name).write_text(book)
     else:
@@ -245,6 +355,17 @@ def main():
           replace_cell(SOLUTION / "06_singularity_study.ipynb", "study", REF_CHECKER_REIMPORT))
     write("sigalrm_sleep", "02_jt_step.ipynb", notebook(SOLUTION / "02_jt_step.ipynb", [SIGALRM_SLEEP]))
     write("remount_plant", "02_jt_step.ipynb", notebook(SOLUTION / "02_jt_step.ipynb", [REMOUNT_PLANT]))
+    write("fill_tmpfs", "02_jt_step.ipynb", notebook(SOLUTION / "02_jt_step.ipynb", [FILL_TMPFS]))
+    write("huge_array", "04_dls_step.ipynb", replace_function(SOLUTION / "04_dls_step.ipynb", HUGE_ARRAY))
+    relay = replace_cell(SOLUTION / "02_jt_step.ipynb", "jt_step", RELAY)
+    write("ipc_relay", "02_jt_step.ipynb", notebook_with(relay, ["_relay_put()"]))
+    for path in sorted(SOLUTION.glob("*.ipynb")):
+        write("cell_magic", path.name, with_cell_magic(path, "%%time"))
+    # graded in a class of their own (tests/test_isolation.py), beside an honest classmate
+    write("storm_class/cpu_storm", "02_jt_step.ipynb",
+          notebook(SOLUTION / "02_jt_step.ipynb", [CPU_STORM]))
+    write("storm_class/shell_escapes", "02_jt_step.ipynb",
+          notebook(SOLUTION / "02_jt_step.ipynb", [SHELL_ESCAPES] * 40))
 
 
 if __name__ == "__main__":

@@ -22,7 +22,16 @@ ETC = ("ld.so.cache", "ld.so.conf", "ld.so.conf.d", "localtime", "timezone", "pa
 NAMESPACES = ["--unshare-user", "--uid", SANDBOX_ID, "--gid", SANDBOX_ID, "--cap-drop", "ALL",
               "--unshare-net", "--unshare-pid", "--unshare-ipc", "--unshare-uts",
               "--unshare-cgroup-try", "--die-with-parent", "--new-session"]
-VARIANTS = (["--disable-userns"], [])  # tried in this order
+# (extra flags, sized tmpfs), tried in this order: an older bwrap has no --disable-userns or --size
+VARIANTS = ((["--disable-userns"], True), ([], True), ([], False))
+TRIAL_TMPFS = 1 << 20
+# syscalls a student's process gets EPERM for: setsid (a new session is a new scheduler
+# autogroup: 200 of them would take the CPU from every other job) and the kernel keyrings
+# (not namespaced: a key would outlive its job); any other ABI (x32, 32-bit) is refused whole
+SECCOMP = {"x86_64": (0xC000003E, {"setsid": 112, "add_key": 248, "request_key": 249,
+                                   "keyctl": 250}),
+           "aarch64": (0xC00000B7, {"setsid": 157, "add_key": 217, "request_key": 218,
+                                    "keyctl": 219})}
 
 
 class SandboxUnavailable(RuntimeError):
@@ -59,9 +68,10 @@ def python_paths(package):
     return [p for i, p in enumerate(kept) if not _inside(p, kept[:i])]
 
 
-def command(bwrap, flags, package, hidden, work, pid1=False):
+def command(bwrap, flags, package, hidden, work, pid1=False, tmpfs_bytes=None, seccomp=None):
     """bwrap ... -- (argv follows): the whitelist, read-only; `work` the only writable folder;
-    `pid1`: argv is the PID namespace's init (the fork server) instead of bwrap's reaper."""
+    `pid1`: argv is the PID namespace's init (the fork server) instead of bwrap's reaper;
+    `tmpfs_bytes`: the size of each writable tmpfs; `seccomp`: the fd of seccomp_program()."""
     args = [bwrap]
     for d in SYSTEM:
         if os.path.islink(d):
@@ -70,33 +80,83 @@ def command(bwrap, flags, package, hidden, work, pid1=False):
             args += ["--ro-bind", d, d]
     for name in ETC:
         args += ["--ro-bind-try", f"/etc/{name}", f"/etc/{name}"]
-    args += ["--ro-bind-try", "/sys/devices/system/cpu", "/sys/devices/system/cpu",
-             "--proc", "/proc", "--dev", "/dev", "--tmpfs", "/tmp", "--tmpfs", "/dev/shm"]
+    args += ["--ro-bind-try", "/sys/devices/system/cpu", "/sys/devices/system/cpu"]
+    args += private_mounts(tmpfs_bytes)
     bound = python_paths(package)
     for path in bound:
         args += ["--ro-bind", str(path), str(path)]
     for path in hidden:  # only what lies inside a bound folder is visible at all
         if _inside(path, bound) and _is_dir(path):
             args += ["--tmpfs", str(path), "--remount-ro", str(path)]
-    args += ["--remount-ro", "/", "--bind", str(work), str(work), "--chdir", str(work)]
+    # the working folder: a tmpfs of its own (nothing of the grader's disk), HOME and TMPDIR in it
+    args += sized_tmpfs(work, tmpfs_bytes) + ["--dir", str(Path(work) / "home" / "tmp")]
+    args += ["--remount-ro", "/", "--chdir", str(work)]
+    args += ["--seccomp", str(seccomp)] if seccomp is not None else []
     return args + NAMESPACES + (["--as-pid-1"] if pid1 else []) + list(flags) + ["--"]
 
 
+def private_mounts(tmpfs_bytes):
+    """What a run may write besides its working folder, RAM-backed and each at most
+    `tmpfs_bytes` (None: no size): /tmp and /dev/shm; /dev itself read-only; POSIX message
+    queues visible in /dev/mqueue (so that the fork server removes a job's with its files)."""
+    return (["--proc", "/proc", "--dev", "/dev", "--mqueue", "/dev/mqueue"]
+            + sized_tmpfs("/dev/shm", tmpfs_bytes) + ["--remount-ro", "/dev"]
+            + sized_tmpfs("/tmp", tmpfs_bytes))
+
+
+def sized_tmpfs(path, tmpfs_bytes):
+    return (["--size", str(tmpfs_bytes)] if tmpfs_bytes else []) + ["--tmpfs", str(path)]
+
+
+def seccomp_program():
+    """The BPF filter bwrap installs (--seccomp FD), as bytes; None on another machine."""
+    import platform
+    import struct
+
+    arch, calls = SECCOMP.get(platform.machine(), (None, {}))
+    if arch is None:
+        return None
+    deny = 5 + len(calls)  # the index of the EPERM return
+    code = [(0x20, 0, 0, 4), (0x15, 0, deny - 2, arch), (0x20, 0, 0, 0),
+            (0x35, deny - 4, 0, 0x40000000)]  # load arch; native? load nr; x32?
+    code += [(0x15, deny - 5 - i, 0, nr) for i, nr in enumerate(calls.values())]
+    code += [(0x06, 0, 0, 0x7FFF0000), (0x06, 0, 0, 0x00050000 | 1)]  # ALLOW, ERRNO(EPERM)
+    return b"".join(struct.pack("HBBI", *op) for op in code)
+
+
+def seccomp_fd():
+    """A pipe's read end holding seccomp_program() (the caller passes it on and closes it)."""
+    program = seccomp_program()
+    if program is None:
+        return None
+    read, write = os.pipe()
+    os.write(write, program)
+    os.close(write)
+    return read
+
+
 def working_flags(bwrap):
-    """(the extra flags this bwrap runs with, None) or (None, why it does not run)."""
+    """((the extra flags this bwrap runs with, whether its tmpfs take a size), None) or
+    (None, why it does not run)."""
     import ikteach
 
     package = Path(ikteach.__file__).resolve().parent
     why = "it does not run"
     with tempfile.TemporaryDirectory(prefix="ikteach-bwrap-") as work:
-        for flags in VARIANTS:
-            argv = command(bwrap, flags, package, [], Path(work)) + [sys.executable, "-S", "-c", ""]
+        for flags, sized in VARIANTS:
+            fd = seccomp_fd()
+            argv = command(bwrap, flags, package, [], Path(work),
+                           tmpfs_bytes=TRIAL_TMPFS if sized else None, seccomp=fd)
             try:
-                run = subprocess.run(argv, capture_output=True, timeout=30, cwd=work)
+                run = subprocess.run(argv + [sys.executable, "-S", "-c", ""], capture_output=True,
+                                     timeout=30, cwd=work, pass_fds=[fd] if fd else [])
             except (OSError, subprocess.SubprocessError) as exc:
                 return None, f"it does not run ({exc})"
+            finally:
+                if fd is not None:
+                    os.close(fd)
             if run.returncode == 0:
-                return flags, None
+                return (flags, sized), None
             text = run.stderr.decode(errors="replace").strip().splitlines()
             why = f"it fails here: {text[-1][:300] if text else f'exit status {run.returncode}'}"
     if "namespace" in why or "Operation not permitted" in why:
@@ -142,4 +202,7 @@ def judge(seen, escaped, hidden):
                  "notebook in a fresh child")
     if seen.get("userns_blocked"):
         lines.append("cannot create user namespaces (so it cannot regain capabilities)")
+    if seen.get("new_session") is False:
+        lines.append("cannot start a session of its own (so a job's processes share one "
+                     "scheduler group) or use the kernel's keyrings (seccomp)")
     return lines

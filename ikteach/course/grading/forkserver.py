@@ -228,7 +228,10 @@ def _child(kind, fds, job, control):
     """The job's process: fresh session and folder, only its pipes; never returns."""
     code = 1
     try:
-        os.setsid()
+        try:
+            os.setsid()
+        except PermissionError:  # in the sandbox: no new sessions (seccomp); its PID namespace
+            pass                 # ends it
         for number in (signal.SIGCHLD, signal.SIGTERM, signal.SIGALRM):
             signal.signal(number, signal.SIG_DFL)
         signal.signal(signal.SIGINT, signal.default_int_handler)

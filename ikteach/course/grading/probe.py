@@ -74,6 +74,17 @@ def userns_blocked(libc):
     return os.waitpid(pid, 0)[1] != 0
 
 
+def new_session():
+    pid = os.fork()
+    if pid == 0:  # in a child: setsid would take this process out of the job's session
+        try:
+            os.setsid()
+            os._exit(0)
+        except OSError:
+            os._exit(1)
+    return os.waitpid(pid, 0)[1] == 0
+
+
 def job(requests_fd, replies_fd):
     """The probe as a job of the fork server (forkserver.py): the request on one pipe, what it
     saw on the other."""
@@ -112,7 +123,7 @@ def main(request):
         seen = {"uid": os.getuid(), "capabilities": capabilities(),
                 "wrote": wrote(request["writes"], request["token"]),
                 "read": readable(request["reads"]), "connected": connected(request["port"]),
-                "mounted": mounted(libc, package), "userns_blocked": userns_blocked(libc),
+                "mounted": mounted(libc, package), "userns_blocked": userns_blocked(libc), "new_session": new_session(),
                 "processes": sum(name.isdigit() for name in os.listdir("/proc")),
                 "server": server_held(libc)}
     try:

@@ -96,8 +96,11 @@ def decode(data, call=None):
             out[key if isinstance(key, (str, int, float, bool, type(None), tuple)) else str(key)] \
                 = decode(v, call)
         return out
-    if "__nd__" in data:
-        return np.array(data["__nd__"], dtype=np.dtype(str(data["dtype"])))
+    if "__nd__" in data:  # numbers only: a dtype such as V1000000000 would fill the memory
+        dtype = np.dtype(str(data["dtype"]))
+        if dtype.kind not in "biuf" or dtype.itemsize > 16:
+            raise ValueError(f"not an array of numbers: {dtype}")
+        return np.array(data["__nd__"], dtype=dtype)
     if "__handle__" in data and call is not None:
         handle = int(data["__handle__"])
         return functools.wraps(_handle_doc)(lambda *args: call(handle, args))

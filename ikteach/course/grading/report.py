@@ -1,9 +1,41 @@
 """The grader's outputs: one CSV row per student (ex1..ex7, total, the sandbox it ran in, notes:
 why a notebook was not graded) and one feedback file per student. Every text is printable UTF-8
-(grading/submissions.text), whatever the file names and notebooks held."""
+(grading/submissions.text), whatever the file names and notebooks held; no CSV cell starts a
+spreadsheet formula; each student's name is NFC-normalised, or written with escapes where two
+names differ only in normalisation; a feedback file name is short whatever the name's length."""
 import csv
+import hashlib
+import unicodedata
 
 from .submissions import text
+
+FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
+MAX_FILE_NAME = 120  # bytes of a feedback file's name before its hash
+
+
+def cell(value):
+    """A CSV cell a spreadsheet shows as text: a leading ' where it would start a formula."""
+    value = str(value)
+    return "'" + value if value.startswith(FORMULA_START) else value
+
+
+def labels(students):
+    """{folder name: the name its row shows}: NFC, unless another folder has the same NFC (then
+    the raw name with every non-ASCII character escaped, so that the rows differ visibly)."""
+    shown = {s: unicodedata.normalize("NFC", text(s)) for s in students}
+    clashes = {n for n in shown.values() if list(shown.values()).count(n) > 1}
+    return {s: (text(s).encode("ascii", "backslashreplace").decode() if n in clashes else n)
+            for s, n in shown.items()}
+
+
+def file_name(label):
+    """A feedback file name for `label` that any file system holds (long names: cut + hash)."""
+    name = label.replace("/", "_").lstrip(".") or "_"
+    raw = name.encode("utf-8")
+    if len(raw) <= MAX_FILE_NAME:
+        return name + ".txt"
+    digest = hashlib.sha256(raw).hexdigest()[:12]
+    return raw[:MAX_FILE_NAME].decode("utf-8", "ignore") + "-" + digest + ".txt"
 
 EXERCISE_NUMBERS = range(1, 8)
 POINTS = 10
@@ -46,10 +78,10 @@ def _best(results):
 
 def write_results(per_student, notes, out, feedback, backend):
     feedback.mkdir(parents=True, exist_ok=True)
-    rows = []
+    rows, shown = [], labels(per_student)
     for student, results in per_student.items():
         best = _best(results)
-        row = {"student": text(student)}
+        row = {"student": shown[student]}
         for number in EXERCISE_NUMBERS:
             row[f"ex{number}"] = best[number]["score"] if number in best else 0.0
         row["total"] = sum(row[f"ex{n}"] for n in EXERCISE_NUMBERS)
@@ -59,7 +91,7 @@ def write_results(per_student, notes, out, feedback, backend):
         page = _feedback_text(row["student"], results)
         if notes[student] and not results:
             page += "".join(f"note: {n}\n" for n in notes[student])
-        (feedback / f"{row['student'].replace('/', '_')}.txt").write_text(page, encoding="utf-8")
+        (feedback / file_name(row["student"])).write_text(page, encoding="utf-8")
     out.parent.mkdir(parents=True, exist_ok=True)
     with open(out, "w", newline="", encoding="utf-8") as handle:
         writer = csv.DictWriter(handle, fieldnames=["student"] + [f"ex{n}" for n in
@@ -67,7 +99,8 @@ def write_results(per_student, notes, out, feedback, backend):
                                 + ["total", "sandbox", "notes"])
         writer.writeheader()
         for row in rows:
-            writer.writerow({k: (f"{v:g}" if isinstance(v, float) else v) for k, v in row.items()})
+            writer.writerow({k: (f"{v:g}" if isinstance(v, float) else cell(v))
+                             for k, v in row.items()})
     return rows
 
 

@@ -6,10 +6,17 @@ run sees a read-only whitelist of the machine (system libraries, a few files of 
 Python the grader runs on, ikteach's package without its checker) and its own working folder;
 /tmp private; no network; own PID, IPC and UTS namespaces; its own user namespace as an
 unprivileged uid with no capabilities, also when the grader runs as root.
+What a run writes lives in memory, size-limited (tmpfs: /tmp, /dev/shm, its working folder;
+/dev read-only); POSIX message queues show in /dev/mqueue, so the fork server removes a job's;
+seccomp refuses new sessions (one scheduler autogroup per sandbox, not one per busy child) and
+the kernel keyrings (not namespaced).
 Always: own HOME, bare environment (BLAS kernel variables passed through, so that the student's
 numbers come from the same kernels as the grader's), resource limits (CPU time, address space,
-file size, no core files), its own process group (ended as a whole, from outside); a cap on
-processes where the cgroup v1 `pids` controller is writable, else RLIMIT_NPROC (not for root).
+file size, no core files), its own process group (ended as a whole, from outside), the OOM
+killer's first choice (oom_score_adj 1000: the grader survives a student's memory); where this
+process may make cgroups (v1 pids/memory/cpu, or v2), one per sandbox: processes (pids.max),
+memory of its processes and files together, an equal CPU share; else RLIMIT_NPROC (not for
+root).
 Student code runs in jobs of a fork server started in the sandbox (servers.py, forkserver.py):
 one bubblewrap per server, a fresh child per notebook run or checks' worker, everything of a job
 killed and removed when it ends. `Sandbox.verify()` runs a probe as such a job and `report()`
@@ -35,7 +42,10 @@ from .bwrap import SandboxUnavailable
 __all__ = ["Limits", "Process", "Sandbox", "SandboxUnavailable", "refusal"]
 
 LAUNCH = Path(__file__).with_name("_launch.py")
-CGROUP_PIDS = Path("/sys/fs/cgroup/pids")
+CGROUP_FS = Path("/sys/fs/cgroup")
+# a sandbox's cgroup (v1: one per controller; v2: one): {limit file: Limits field}
+CGROUP_LIMITS = {"pids.max": "processes", "memory.limit_in_bytes": "memory_mb",
+                 "memory.max": "memory_mb"}
 # BLAS/LAPACK kernel and thread settings: the student's process must compute with the same
 # kernels as the grader's (another OpenBLAS kernel changes the last bits of an SVD)
 PASSED_THROUGH = ("OPENBLAS_CORETYPE", "OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS",
@@ -53,17 +63,39 @@ class Limits:
     memory_mb: int = 4096
     processes: int = 256
     file_mb: int = 256
+    tmpfs_mb: int = 256  # each of a sandbox's /tmp, /dev/shm and working folder
+
+    def cgroup_value(self, field):
+        value = getattr(self, field)
+        return value << 20 if field.endswith("_mb") else value
 
 
-def _cgroup_works():
-    probe = CGROUP_PIDS / f"ikteach-probe-{secrets.token_hex(4)}"
+def _cgroup_parents():
+    """This process's own cgroups (pids, memory, cpu of v1; the v2 tree) where it may make
+    one for a sandbox: {folder: the controllers a child there gets}."""
     try:
-        probe.mkdir()
-        ok = (probe / "pids.max").exists()
-        probe.rmdir()
-        return ok
+        lines = Path("/proc/self/cgroup").read_text().splitlines()
     except OSError:
-        return False
+        return {}
+    found = {}
+    for line in lines:
+        _, controllers, path = line.split(":", 2)
+        for name in controllers.split(",") if controllers else [""]:
+            if name in ("pids", "memory", "cpu") or (
+                    not name and (CGROUP_FS / "cgroup.controllers").exists()):
+                folder = CGROUP_FS / name / path.lstrip("/")
+                probe = folder / f"ikteach-probe-{secrets.token_hex(4)}"
+                try:
+                    probe.mkdir()
+                except OSError:
+                    continue
+                files = {f.name for f in probe.iterdir()}
+                probe.rmdir()
+                found[folder] = ({"pids": "pids.max", "memory": "memory.max" if not name else
+                                  "memory.limit_in_bytes", "cpu": "cpu.weight" if not name else
+                                  "cpu.shares"}, files)
+    return {folder: {c for c, f in kinds.items() if f in files}
+            for folder, (kinds, files) in found.items()}
 
 
 def refusal(tried):
@@ -85,9 +117,10 @@ class Sandbox:
         self.package = Path(__file__).resolve().parents[2]  # ikteach/
         self.hidden = [Path(p).resolve() for p in hidden if p and os.path.lexists(p)]
         self.hidden += [self.package / "course" / "check", self.work_root]  # the checker too
-        self.cgroup = _cgroup_works()
+        self.cgroups = _cgroup_parents()
+        self.controlled = set().union(*self.cgroups.values())
         self.root = os.geteuid() == 0
-        self.tried, self.verified, self.flags = [], [], None
+        self.tried, self.verified, self.flags, self.sized_tmpfs = [], [], None, False
         self.bwrap = None
         path = shutil.which("bwrap") if bwrap is None else (bwrap or None)
         if bwrap is False:
@@ -95,11 +128,11 @@ class Sandbox:
         elif not path:
             self.tried.append("bubblewrap: `bwrap` not found on PATH")
         else:
-            self.flags, why = _bwrap.working_flags(path)
-            if self.flags is None:
+            variant, why = _bwrap.working_flags(path)
+            if variant is None:
                 self.tried.append(f"bubblewrap ({path}): {why}")
             else:
-                self.bwrap = path
+                self.bwrap, (self.flags, self.sized_tmpfs) = path, variant
         self.unsandboxed = self.bwrap is None and bool(unsandboxed)
         if self.bwrap is None and not unsandboxed:
             self.close()
@@ -160,15 +193,25 @@ class Sandbox:
 
     def report(self):
         """(enforced, not enforced): lists of short lines for the grader's log."""
-        lim = self.limits
+        lim, has = self.limits, self.controlled
         yes = ["own temporary working folder and HOME, bare environment",
                f"CPU time {lim.cpu_seconds} s per process (RLIMIT_CPU)",
                f"memory {lim.memory_mb} MiB address space per process (RLIMIT_AS)",
                f"file size {lim.file_mb} MiB (RLIMIT_FSIZE), no core files",
                "wall-clock time limits, applied from outside; the process group is killed "
-               "as a whole"]
+               "as a whole",
+               "when memory runs out, the kernel ends students' processes first "
+               "(oom_score_adj 1000), never the grader"]
         no = []
-        if self.cgroup:
+        if "memory" in has:
+            yes.append(f"memory: at most {lim.memory_mb} MiB for a sandbox's processes and "
+                       "files together (cgroup)")
+        else:
+            no.append("memory of a job's processes together (no memory cgroup here): bounded "
+                      "per process and by the file systems' sizes only")
+        if "cpu" in has:
+            yes.append("CPU: each sandbox (one notebook at a time) an equal share (cgroup)")
+        if "pids" in has:
             yes.append(f"processes: at most {lim.processes} (cgroup pids.max)")
         elif not self.root:
             yes.append(f"processes: at most {lim.processes} for this user (RLIMIT_NPROC)")
@@ -177,6 +220,12 @@ class Sandbox:
                       "writable): a fork storm is bounded only by the CPU and time limits")
         if self.bwrap:
             yes += [f"{line} (checked at start-up)" for line in self.verified]
+            if self.sized_tmpfs:
+                yes.append(f"its files: /tmp, /dev/shm and its working folder in memory, at "
+                           f"most {lim.tmpfs_mb} MiB each; /dev read-only")
+            else:
+                no.append("the size of /tmp, /dev/shm and the working folder (this bwrap has "
+                          "no --size): files there are bounded by memory only")
             yes.append("visible, read-only, by its mount list (probed only as above): the "
                        "system libraries, the grader's Python, ikteach's package without its "
                        "checker; nothing else of this machine")
@@ -188,26 +237,36 @@ class Sandbox:
                    "processes that leave the process group (setsid) may outlive the run"]
         return yes, no
 
-    def _cgroup_dir(self):
-        if not self.cgroup:
-            return None
-        path = CGROUP_PIDS / f"ikteach-{os.getpid()}-{secrets.token_hex(4)}"
-        path.mkdir()
-        (path / "pids.max").write_text(str(self.limits.processes))
-        return path
+    def _cgroups(self):
+        """New cgroups for one sandbox (with its limits written); [] where there are none."""
+        made = []
+        for parent, controllers in self.cgroups.items():
+            path = parent / f"ikteach-{os.getpid()}-{secrets.token_hex(4)}"
+            try:
+                path.mkdir()
+            except OSError:
+                continue
+            made.append(path)
+            for name, field in CGROUP_LIMITS.items():
+                try:
+                    (path / name).write_text(str(self.limits.cgroup_value(field)))
+                except OSError:  # not this cgroup version's file, or not writable
+                    pass
+        return made
 
-    def command(self, argv, work, cgroup, pid1=False):
+    def command(self, argv, work, cgroups, pid1=False, seccomp=None):
         """The full command line: launcher (limits), then bwrap (if any), then argv (`pid1`:
-        as the init of its PID namespace)."""
+        as the init of its PID namespace; `seccomp`: the fd of bwrap's filter)."""
         lim = self.limits
-        nproc = lim.processes if (not self.root and not self.cgroup) else 0
+        nproc = lim.processes if (not self.root and "pids" not in self.controlled) else 0
         launch = [sys.executable, "-S", str(LAUNCH), str(lim.cpu_seconds),
                   str(lim.memory_mb << 20), str(lim.file_mb << 20), str(nproc),
-                  str(cgroup) if cgroup else "-", "--"]
+                  ",".join(map(str, cgroups)) or "-", "--"]
         if not self.bwrap:
             return launch + list(argv)
+        tmpfs = lim.tmpfs_mb << 20 if self.sized_tmpfs else None
         return launch + _bwrap.command(self.bwrap, self.flags, self.package, self.hidden,
-                                       Path(work), pid1) + list(argv)
+                                       Path(work), pid1, tmpfs, seccomp) + list(argv)
 
     def environment(self, work):
         home = Path(work) / "home"
@@ -219,19 +278,25 @@ class Sandbox:
         env.update({k: os.environ[k] for k in PASSED_THROUGH if k in os.environ})
         return env
 
-    def start(self, argv, work, pid1=False, **popen):
+    def start(self, argv, work, pid1=False, pass_fds=(), **popen):
         """A running Process for argv in `work` (a folder the caller created)."""
-        cgroup = self._cgroup_dir()
-        proc = subprocess.Popen(self.command(argv, work, cgroup, pid1), cwd=work,
-                                env=self.environment(work), **popen)
-        return Process(proc, cgroup)
+        cgroups = self._cgroups()
+        seccomp = _bwrap.seccomp_fd() if self.bwrap else None
+        fds = tuple(pass_fds) + ((seccomp,) if seccomp is not None else ())
+        try:
+            proc = subprocess.Popen(self.command(argv, work, cgroups, pid1, seccomp), cwd=work,
+                                    env=self.environment(work), pass_fds=fds, **popen)
+        finally:
+            if seccomp is not None:
+                os.close(seccomp)
+        return Process(proc, cgroups)
 
 
 class Process:
     """A sandboxed process; end() kills it and everything it started."""
 
-    def __init__(self, proc, cgroup):
-        self.proc, self.cgroup = proc, cgroup
+    def __init__(self, proc, cgroups):
+        self.proc, self.cgroups = proc, cgroups
 
     def wait(self, timeout):
         """Its exit status, or None when it ran past `timeout` seconds (it is then ended)."""
@@ -246,10 +311,10 @@ class Process:
             os.killpg(self.proc.pid, signal.SIGKILL)
         except (ProcessLookupError, PermissionError):
             pass
-        if self.cgroup:
+        for cgroup in self.cgroups:  # unsandboxed: what left the process group (setsid)
             for _ in range(50):
                 try:
-                    pids = (self.cgroup / "cgroup.procs").read_text().split()
+                    pids = (cgroup / "cgroup.procs").read_text().split()
                 except OSError:
                     break
                 if not pids:
@@ -261,7 +326,7 @@ class Process:
                         pass
                 time.sleep(0.02)
             try:
-                self.cgroup.rmdir()
+                cgroup.rmdir()
             except OSError:
                 pass
         try:
