@@ -162,10 +162,10 @@ def test_tree_animation_titles_each_frame_with_its_time_and_has_a_still():
     anim = tree_plot.animate_tree(Y, thetas, targets, times=times, title="Y tree, SDLS")
     assert list(anim.iterations) == [0, 1, 2] and anim.still == 2
     ax = anim._fig.axes[0]
-    assert ax.get_title() == "Y tree, SDLS: t =  0.50 s"  # laid out at the last frame
+    assert ax.get_title() == "Y tree, SDLS: τ =  0.50"  # laid out at the last frame (Buss's time τ)
     assert {t.get_text() for t in ax.get_legend().get_texts()} >= {"end effectors", "targets"}
     anim._draw_frame(1)
-    assert ax.get_title() == "Y tree, SDLS: t =  0.25 s"
+    assert ax.get_title() == "Y tree, SDLS: τ =  0.25"
     assert plot.still_png(anim)[:8] == b"\x89PNG\r\n\x1a\n"
 
 
