@@ -8,10 +8,11 @@ MODULES = (ex01_jacobian, ex02_jt_step, ex03_pinv_step, ex04_dls_step, ex05_stop
 EXERCISES = {module.NUMBER: module for module in MODULES}
 
 
-def grade(number, namespace):
+def grade(number, namespace, seed=None):
     """The verdict for exercise `number`, taking the student's functions from `namespace`
-    (a dict: a notebook's globals, or the grader's proxies). Missing functions fail with a
-    message; nothing is printed."""
+    (a dict: a notebook's globals, or the grader's proxies), on the hidden cases drawn from
+    `seed` (None: the instant check's cases). Missing functions fail with a message; nothing
+    is printed."""
     if number not in EXERCISES:
         raise ValueError(f"number: expected one of {sorted(EXERCISES)}, got {number!r}")
     module = EXERCISES[number]
@@ -21,7 +22,7 @@ def grade(number, namespace):
             f"{', '.join('`' + n + '`' for n in missing)} not found in the notebook: keep the "
             "function names of the template."))]
         return _evaluate(number, module.TITLE, list(module.FUNCTIONS), parts)
-    return module.verdict(*(namespace[n] for n in module.FUNCTIONS))
+    return module.verdict(*(namespace[n] for n in module.FUNCTIONS), seed=seed)
 
 
 def refuse(number, message):

@@ -59,9 +59,10 @@ def python_paths(package):
     return [p for i, p in enumerate(kept) if not _inside(p, kept[:i])]
 
 
-def command(bwrap, flags, package, hidden, work, pid1=False):
+def command(bwrap, flags, package, hidden, work, pid1=False, copy=None):
     """bwrap ... -- (argv follows): the whitelist, read-only; `work` the only writable folder;
-    `pid1`: argv is the PID namespace's init (the fork server) instead of bwrap's reaper."""
+    `pid1`: argv is the PID namespace's init (the fork server) instead of bwrap's reaper;
+    `copy`: a copy of ikteach shown in place of `package` (reference.py)."""
     args = [bwrap]
     for d in SYSTEM:
         if os.path.islink(d):
@@ -75,6 +76,8 @@ def command(bwrap, flags, package, hidden, work, pid1=False):
     bound = python_paths(package)
     for path in bound:
         args += ["--ro-bind", str(path), str(path)]
+    if copy is not None:
+        args += ["--ro-bind", str(copy), str(package)]
     for path in hidden:  # only what lies inside a bound folder is visible at all
         if _inside(path, bound) and _is_dir(path):
             args += ["--tmpfs", str(path), "--remount-ro", str(path)]

@@ -1,5 +1,6 @@
 """The grader's outputs: one CSV row per student (ex1..ex7, total, the sandbox it ran in, notes:
-why a notebook was not graded) and one feedback file per student. Every text is printable UTF-8
+why a notebook was not graded, copied: graded code that is ikteach's own answer, for the
+instructor to judge) and one feedback file per student. Every text is printable UTF-8
 (grading/submissions.text), whatever the file names and notebooks held."""
 import csv
 
@@ -22,6 +23,9 @@ def _feedback_text(student, results):
             lines.append(f"  {line}")
         for note in r["notes"]:
             lines.append(f"  note: {note}")
+        for line in r.get("copied", []):
+            lines.append(f"  for the instructor: {line} (compiled code compared, names and "
+                         "docstrings ignored); the marks stand until the instructor decides")
         if r.get("answer", "").strip():
             lines.append("  your written answer (not marked by the checker; read by the "
                          "instructor):")
@@ -55,6 +59,8 @@ def write_results(per_student, notes, out, feedback, backend):
         row["total"] = sum(row[f"ex{n}"] for n in EXERCISE_NUMBERS)
         row["sandbox"] = backend
         row["notes"] = text(" | ".join(notes[student]))[:2000]
+        row["copied"] = text(" | ".join(f"ex{n}: {line}" for n in EXERCISE_NUMBERS
+                                        if n in best for line in best[n].get("copied", [])))
         rows.append(row)
         page = _feedback_text(row["student"], results)
         if notes[student] and not results:
@@ -64,7 +70,7 @@ def write_results(per_student, notes, out, feedback, backend):
     with open(out, "w", newline="", encoding="utf-8") as handle:
         writer = csv.DictWriter(handle, fieldnames=["student"] + [f"ex{n}" for n in
                                                                   EXERCISE_NUMBERS]
-                                + ["total", "sandbox", "notes"])
+                                + ["total", "sandbox", "notes", "copied"])
         writer.writeheader()
         for row in rows:
             writer.writerow({k: (f"{v:g}" if isinstance(v, float) else v) for k, v in row.items()})

@@ -196,9 +196,20 @@ class Sandbox:
         (path / "pids.max").write_text(str(self.limits.processes))
         return path
 
-    def command(self, argv, work, cgroup, pid1=False):
+    def package_for(self, exercise):
+        """The copy of ikteach that the jobs of `exercise` see (None: a probe's, nothing
+        stubbed): reference.py, the reference rule."""
+        from ..check import EXERCISES
+        from .reference import sandbox_copy
+
+        references = EXERCISES[exercise].REFERENCES if exercise is not None else ()
+        folder = self.work_root / f"package-{exercise or 0}"
+        folder.mkdir(exist_ok=True)
+        return sandbox_copy(self.package, folder / "ikteach", references, exercise)
+
+    def command(self, argv, work, cgroup, pid1=False, package=None):
         """The full command line: launcher (limits), then bwrap (if any), then argv (`pid1`:
-        as the init of its PID namespace)."""
+        as the init of its PID namespace; `package`: the copy of ikteach it sees)."""
         lim = self.limits
         nproc = lim.processes if (not self.root and not self.cgroup) else 0
         launch = [sys.executable, "-S", str(LAUNCH), str(lim.cpu_seconds),
@@ -207,23 +218,25 @@ class Sandbox:
         if not self.bwrap:
             return launch + list(argv)
         return launch + _bwrap.command(self.bwrap, self.flags, self.package, self.hidden,
-                                       Path(work), pid1) + list(argv)
+                                       Path(work), pid1, package) + list(argv)
 
-    def environment(self, work):
+    def environment(self, work, package=None):
         home = Path(work) / "home"
         (home / "tmp").mkdir(parents=True, exist_ok=True)
         env = {"PATH": f"{Path(sys.executable).parent}:/usr/local/bin:/usr/bin:/bin",
                "HOME": str(home), "TMPDIR": str(home / "tmp"), "LANG": "C.UTF-8",
                "MPLBACKEND": "Agg", "JAX_PLATFORMS": "cpu", "PYTHONDONTWRITEBYTECODE": "1",
-               "PYTHONNOUSERSITE": "1", "PYTHONPATH": str(self.package.parent)}
+               "PYTHONNOUSERSITE": "1", "PYTHONPATH": str((package or self.package).parent)}
         env.update({k: os.environ[k] for k in PASSED_THROUGH if k in os.environ})
         return env
 
-    def start(self, argv, work, pid1=False, **popen):
-        """A running Process for argv in `work` (a folder the caller created)."""
+    def start(self, argv, work, pid1=False, exercise=None, **popen):
+        """A running Process for argv in `work` (a folder the caller created), seeing the copy
+        of ikteach made for `exercise`."""
         cgroup = self._cgroup_dir()
-        proc = subprocess.Popen(self.command(argv, work, cgroup, pid1), cwd=work,
-                                env=self.environment(work), **popen)
+        package = self.package_for(exercise)
+        proc = subprocess.Popen(self.command(argv, work, cgroup, pid1, package), cwd=work,
+                                env=self.environment(work, package), **popen)
         return Process(proc, cgroup)
 
 

@@ -1,0 +1,179 @@
+"""The reference rule: what the grader guarantees about ikteach's own answers, and what it only
+reports.
+
+Guaranteed (with bubblewrap): while exercise N is graded, every process of its sandbox (the
+fork server, the notebook's run, the checks' worker, anything they start) sees a COPY of
+ikteach (sandbox_copy) in which exercise N's reference functions (its check module's
+REFERENCES) have a body that raises ReferenceBlocked, and which holds no checker and no
+self-check answer. A reload, an exec of ikteach's source file, a fresh interpreter, a pickle
+by reference: all find the stub. The expected values are computed in the grader's own
+process, outside the sandbox; only the student's outputs come back.
+
+Reported, not prevented: a notebook that carries ikteach's code in itself (its source typed or
+pasted in, a marshalled code object, an exec'd string). That is copying, which only a reader
+can judge; fingerprint() makes it visible: a code object's hash that ignores names,
+docstrings, file names and line numbers, compared with the references' and the self-check's
+(copied()). The grader writes what matched into grades.csv and the feedback.
+"""
+import ast
+import compileall
+import hashlib
+import importlib
+import os
+import shutil
+import tempfile
+import types
+from pathlib import Path
+
+# what no job imports: the checks (expected values, diagnoses), the grader, the self-check's
+# answer, the bundles; left out of the sandbox's copy
+LEFT_OUT = ("course/check", "course/grade.py", "course/grading/selfcheck.py",
+            "course/grading/gradescope.py", "course/grading/autograder.py")
+MIN_CODE_BYTES = 40  # smaller functions (a one-line wrapper) are too common to report
+
+
+def _stub_body(qualname, exercise):
+    label = (f"ikteach's {qualname} is the reference answer of exercise {exercise}; graded "
+             "code must compute it itself")
+    return ast.parse("from ikteach.course.grading.own_code import ReferenceBlocked\n"
+                     f"raise ReferenceBlocked({label!r})\n").body
+
+
+def stub_source(source, names, exercise):
+    """`source` (a module's text) with the top-level functions `names` raising instead; their
+    signatures and decorators stay, so every caller (jit, a method table) still works."""
+    tree = ast.parse(source)
+    found = set()
+    for node in tree.body:
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and node.name in names:
+            node.body = _stub_body(node.name, exercise)
+            found.add(node.name)
+    if found != set(names):
+        raise ValueError(f"references: {sorted(set(names) - found)} are not top-level "
+                         "functions of their module")
+    return ast.unparse(tree) + "\n"
+
+
+def sandbox_copy(package, dest, references=(), exercise=None):
+    """The folder `dest` (made once: a finished copy is reused), a copy of ikteach's
+    `package` without LEFT_OUT, its `references` ("ikteach.core.x:fn") stubbed, compiled."""
+    dest = Path(dest)
+    if dest.is_dir():
+        return dest
+    staging = Path(tempfile.mkdtemp(prefix=".copy-", dir=dest.parent)) / "ikteach"
+    shutil.copytree(package, staging, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    for left_out in LEFT_OUT:
+        path = staging / left_out
+        if path.is_dir():
+            shutil.rmtree(path)
+            path.mkdir()  # an empty folder: the sandbox lays a tmpfs over it
+        else:
+            path.unlink(missing_ok=True)
+    by_module = {}
+    for ref in references:
+        module, name = ref.split(":")
+        by_module.setdefault(module, []).append(name)
+    for module, names in by_module.items():
+        path = staging.joinpath(*module.split(".")[1:]).with_suffix(".py")
+        path.write_text(stub_source(path.read_text(encoding="utf-8"), names, exercise),
+                        encoding="utf-8")
+    compileall.compile_dir(str(staging), quiet=2, ddir=str(package))
+    try:
+        os.rename(staging, dest)
+    except OSError:  # another grading process made it first
+        shutil.rmtree(staging.parent, ignore_errors=True)
+    return dest
+
+
+# --- fingerprints: copied code, reported ---------------------------------------------------
+
+def fingerprint(code):
+    """A hash of what `code` does: its bytecode, its numbers and its nested functions', not
+    its names, docstring, file or line numbers (a copy with renamed variables matches)."""
+    digest = hashlib.sha256(code.co_code)
+    for const in code.co_consts:
+        if isinstance(const, types.CodeType):
+            digest.update(fingerprint(const).encode())
+        elif isinstance(const, (int, float, complex, tuple)) and not isinstance(const, bool):
+            digest.update(repr(const).encode())
+    return digest.hexdigest()[:24]
+
+
+def _codes(code):
+    yield code
+    for const in code.co_consts:
+        if isinstance(const, types.CodeType):
+            yield from _codes(const)
+
+
+def fingerprints(codes):
+    """{hash: function name} of every function in `codes` and nested in them (big enough)."""
+    return {fingerprint(c): c.co_name for code in codes for c in _codes(code)
+            if c.co_name != "<module>" and len(c.co_code) >= MIN_CODE_BYTES}
+
+
+def _python_function(obj):
+    for _ in range(8):
+        if isinstance(obj, types.FunctionType):
+            return obj
+        obj = getattr(obj, "__wrapped__", None)
+    return None
+
+
+def reference_fingerprints(references, extra_sources=()):
+    """{hash: what it is} of ikteach's reference functions and of answers given as source."""
+    out = {}
+    for ref in references:
+        module, name = ref.split(":")
+        fn = _python_function(getattr(importlib.import_module(module), name))
+        if fn is not None:
+            out.update({h: f"{module}.{name}" for h in fingerprints([fn.__code__])})
+    for label, source in extra_sources:
+        out.update({h: label for h in fingerprints([compile(source, label, "exec")])})
+    return out
+
+
+def held_code(namespace, depth=3):
+    """The code objects the values of `namespace` hold: functions, their wrappers, closures,
+    defaults and globals they name, classes' methods, bare code objects (in the worker)."""
+    seen, out = set(), []
+
+    def visit(obj, left):
+        if id(obj) in seen or left < 0:
+            return
+        seen.add(id(obj))
+        if isinstance(obj, types.CodeType):
+            out.append(obj)
+        elif isinstance(obj, (types.FunctionType, types.MethodType)):
+            fn = getattr(obj, "__func__", obj)
+            out.append(fn.__code__)
+            for cell in fn.__closure__ or ():
+                visit(cell.cell_contents if cell.cell_contents is not None else None, left - 1)
+            for value in list(fn.__defaults__ or ()) + [fn.__globals__.get(n)
+                                                        for n in fn.__code__.co_names]:
+                visit(value, left - 1)
+        elif isinstance(obj, type):
+            for value in list(vars(obj).values()):
+                visit(getattr(value, "__func__", value), left - 1)
+        elif isinstance(obj, (list, tuple, dict)):
+            for value in list(obj.values() if isinstance(obj, dict) else obj)[:100]:
+                visit(value, left - 1)
+        if getattr(obj, "__wrapped__", None) is not None:
+            visit(obj.__wrapped__, left - 1)
+        if getattr(obj, "func", None) is not None and callable(obj):
+            visit(obj.func, left - 1)
+
+    for value in list(namespace.values()):
+        try:
+            visit(value, depth)
+        except Exception:  # noqa: BLE001 - a student's odd object: its code is not visited
+            continue
+    return out
+
+
+def copied(found, references):
+    """Lines for the instructor: which of the notebook's functions (`found`: {hash: name})
+    have the same code as a reference (`references`: {hash: what})."""
+    lines = sorted({f"`{name}` has the same code as {references[h]}"
+                    for h, name in found.items() if h in references})
+    return lines[:5]
