@@ -118,7 +118,8 @@ def test_pinv_without_a_guard_for_a_zero_jacobian():
         return Vt.T @ (inv * (U.T @ e))
     verdict = check.pinv_step_verdict(unguarded)
     assert verdict.score == 8 and "no guard for sigma_max = 0" in verdict.message
-    assert verdict.parts == {"regular": True, "cut-off": True, "J = 0": False}
+    assert verdict.parts == {"regular": True, "sign": True, "small sigma dropped": True,
+                             "sigma_max = 0 guard": False}
 
 
 def test_pinv_absolute_cutoff():
@@ -128,6 +129,56 @@ def test_pinv_absolute_cutoff():
         return Vt.T @ (inv * (U.T @ e))
     verdict = check.pinv_step_verdict(absolute)
     assert verdict.score == 7 and "must be relative" in verdict.message
+
+
+def pinv_fixed_cutoff(cutoff):
+    """A pinv_step that ignores rcond: a fixed relative cut-off (np.linalg.pinv's is 1e-15)."""
+    def step(J, e, rcond):
+        U, s, Vt = np.linalg.svd(J, full_matrices=False)
+        keep = (s >= cutoff * s.max(initial=0.0)) & (s > 0)
+        return Vt.T @ (np.where(keep, 1 / np.where(keep, s, 1), 0) * (U.T @ e))
+    return step
+
+
+@pytest.mark.parametrize("seed", [None, 1, 2, 3])
+@pytest.mark.parametrize("cutoff", [1e-1, 1e-2, 1e-3, 1e-4, 1e-5])
+def test_pinv_ignoring_rcond_loses_the_cutoff_points(seed, cutoff):
+    """Cases with sigma_min / sigma_max between 1e-5 and 0.1 and rcond on either side: a
+    fixed cut-off keeps what rcond drops or drops what it keeps - in the instant check and in
+    every draw of the hidden cases."""
+    verdict = check.pinv_step_verdict(pinv_fixed_cutoff(cutoff), seed=seed)
+    assert verdict.score == 7 and not verdict.parts["small sigma dropped"], verdict.message
+    assert "ignores `rcond`: on every case it drops what a fixed relative cut-off of" \
+        in verdict.message, verdict.message  # (1e-2 and 1e-3 drop the same on some draws)
+
+
+def test_np_linalg_pinv_is_told_it_has_no_cutoff():
+    verdict = check.pinv_step_verdict(lambda J, e, rcond: np.linalg.pinv(J) @ e)
+    assert verdict.score == 7 and "no cut-off" in verdict.message
+    assert "np.linalg.pinv(J) keeps every sigma_i >= 1e-15 sigma_max" in verdict.message
+
+
+def test_pinv_with_u_and_v_swapped_gets_a_hint_not_only_numpys_error():
+    def swapped(J, e, rcond):
+        U, s, Vt = np.linalg.svd(J, full_matrices=False)
+        keep = (s >= rcond * s[0]) & (s > 0)
+        return U @ (np.where(keep, 1 / np.where(keep, s, 1), 0) * (Vt @ e))
+    verdict = check.pinv_step_verdict(swapped)
+    assert verdict.score == 0, verdict.message
+    assert "mismatch in its core dimension" in verdict.message  # what numpy said, and then
+    assert "hint: J (m x n) = U Sigma V^T" in verdict.message and "U and V swapped?" in verdict.message
+    square = check.pinv_step_verdict(lambda J, e, r: swapped(J, e, r) if J.shape[0] == J.shape[1]
+                                     else np.asarray(ik.pinv_step(J, e, r)))
+    assert square.score < 10 and "U and V swapped: delta_theta = V Sigma^+ U^T e" in square.message
+
+
+@pytest.mark.parametrize("seed", [None, 5])
+def test_a_sign_slip_costs_the_same_in_exercises_2_and_3(seed):
+    jt = check.jt_step_verdict(lambda J, e: -jt_step(J, e), seed=seed)
+    pinv = check.pinv_step_verdict(lambda J, e, r: -np.asarray(ik.pinv_step(J, e, r)), seed=seed)
+    assert jt.score == pinv.score == 7, (jt.message, pinv.message)
+    assert "wrong sign" in jt.message and "wrong sign" in pinv.message
+    assert not jt.parts["sign"] and not pinv.parts["sign"]
 
 
 def test_dls_lambda_not_squared_and_partial_credit():

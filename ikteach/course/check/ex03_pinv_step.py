@@ -161,7 +161,14 @@ def _pinv_parts(fn, name, seed=None):
                 continue
             if _close(got, -want):
                 return "wrong sign: delta_theta = +J^+ e." + _mismatch(got, want, case)
-            fixed = _fixed_cutoff([(c, result(c)) for c in cases if c.tag == tag])
+            results = [(c, result(c)) for c in cases if c.tag == tag]
+            if tag == "cutoff" and all(  # every case: sigma_i < rcond dropped
+                    _close(np.abs(g), np.abs(_pinv_variant(*c.args[:2], lambda s, r=c.args[2]:
+                                                            s >= r))) for c, g in results):
+                return ("the cut-off must be relative: drop sigma_i < rcond * sigma_max "
+                        "(the largest singular value), not sigma_i < rcond."
+                        + _mismatch(got, want, case))
+            fixed = _fixed_cutoff(results)
             if tag == "cutoff" and fixed is not None:
                 return (f"your cut-off ignores `rcond`: on every case it drops what a fixed "
                         f"relative cut-off of {fixed:g} drops; here rcond = {rcond:g}. Drop "

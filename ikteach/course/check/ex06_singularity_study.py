@@ -113,8 +113,10 @@ def _study_parts(study):
     return [question(key) for key in _QUESTIONS]
 
 
-def verdict(study):
-    """Verdict for exercise 6 without printing."""
+def verdict(study, seed=None):
+    """Verdict for exercise 6 without printing. `seed` is not used: the study's answers are
+    values read off the notebook's own runs (fixed arm and targets), so there are no hidden
+    cases - the instructor reads the code and the written answer."""
     return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _study_parts(study))
 
 
