@@ -98,7 +98,7 @@ def test_correct_step_gets_full_marks():
 
 
 def test_module_step_gets_full_marks():
-    verdict = ik.check.priority_step_verdict(lambda *a: np.asarray(ik.priority_step(*a)))
+    verdict = ik.check.ex07_priority_step.verdict(lambda *a: np.asarray(ik.priority_step(*a)))
     assert verdict.passed and verdict.score == 10, verdict.message
 
 

@@ -8,7 +8,7 @@ import numpy as np
 from ...core.chain import planar_chain
 from ...core.jacobian import jacobian as _ref_jacobian
 from .verdicts import (_Case, _Fail, _Part, _as_array, _call, _close, _evaluate, _fmt,
-                       _guarded, _mismatch, _report, _rng, _shape_message)
+                       _guarded, _mismatch, _rng, _shape_message)
 
 NUMBER = 1
 CHECK_NAME = "jacobian"
@@ -134,8 +134,3 @@ def verdict(planar_jacobian, seed=None):
     """Verdict for exercise 1 without printing (`seed`: the grader's hidden cases)."""
     return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _guarded(
         planar_jacobian, FUNCTIONS[0], lambda fn, name: _jacobian_parts(fn, name, seed)))
-
-
-def check(planar_jacobian):
-    """Exercise 1: check planar_jacobian(lengths, theta) -> J (2, n), column i = z x (p_e - p_i)."""
-    _report(verdict(planar_jacobian))

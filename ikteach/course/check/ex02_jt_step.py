@@ -7,7 +7,7 @@ import numpy as np
 
 from ...core.jt import jt_step as _ref_jt
 from .verdicts import (_Case, _Fail, _Part, _as_array, _call, _close, _evaluate, _guarded,
-                       _matrix_text, _mismatch, _report, _rng, _shape_message)
+                       _matrix_text, _mismatch, _rng, _shape_message)
 
 NUMBER = 2
 CHECK_NAME = "jt_step"
@@ -144,8 +144,3 @@ def verdict(jt_step, seed=None):
     """Verdict for exercise 2 without printing (`seed`: the grader's hidden cases)."""
     return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _guarded(
         jt_step, FUNCTIONS[0], lambda fn, name: _jt_parts(fn, name, seed)))
-
-
-def check(jt_step):
-    """Exercise 2: check jt_step(J, e) -> alpha J^T e with Buss's optimal alpha."""
-    _report(verdict(jt_step))

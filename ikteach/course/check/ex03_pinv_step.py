@@ -8,7 +8,7 @@ import numpy as np
 
 from ...core.pinv import pinv_step as _ref_pinv
 from .verdicts import (_Case, _Fail, _Part, _as_array, _call, _close, _evaluate, _fmt, _guarded,
-                       _matrix_text, _mismatch, _report, _rng, _shape_message, _random_matrix,
+                       _matrix_text, _mismatch, _rng, _shape_message, _random_matrix,
                        _with_singular_values)
 
 NUMBER = 3
@@ -191,8 +191,3 @@ def verdict(pinv_step, seed=None):
     """Verdict for exercise 3 without printing (`seed`: the grader's hidden cases)."""
     return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _guarded(
         pinv_step, FUNCTIONS[0], lambda fn, name: _pinv_parts(fn, name, seed)))
-
-
-def check(pinv_step):
-    """Exercise 3: check pinv_step(J, e, rcond) -> J^+ e by the SVD with a relative cut-off."""
-    _report(verdict(pinv_step))

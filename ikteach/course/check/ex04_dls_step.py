@@ -6,7 +6,7 @@ import numpy as np
 
 from ...core.dls import dls_step as _ref_dls
 from .verdicts import (_Case, _Part, _as_array, _call, _check_callable, _close, _evaluate,
-                       _fmt, _matrix_text, _mismatch, _report, _rng, _shape_message)
+                       _fmt, _matrix_text, _mismatch, _rng, _shape_message)
 
 NUMBER = 4
 CHECK_NAME = "dls_step"
@@ -110,8 +110,3 @@ def verdict(dls_step, dls_step_normal, seed=None):
     names = list(FUNCTIONS)
     return _evaluate(NUMBER, TITLE, names,
                      _dls_parts([dls_step, dls_step_normal], names, seed))
-
-
-def check(dls_step, dls_step_normal):
-    """Exercise 4: check both DLS forms against ik.dls_step, and against each other."""
-    _report(verdict(dls_step, dls_step_normal))

@@ -11,7 +11,7 @@ from ...core.dls import dls_step as _ref_dls
 from ...core.solve import StopSolve
 from ...core.solve import solve as _solve
 from .verdicts import (SOLVE_LIMIT, _Case, _Fail, _Part, _call, _check_callable, _evaluate,
-                       _fmt, _report, _rng)
+                       _fmt, _rng)
 
 NUMBER = 5
 CHECK_NAME = "stop_rule"
@@ -200,8 +200,3 @@ def verdict(stalled, stop_rule_step, seed=None):
     """Verdict for exercise 5 without printing (`seed`: the grader's hidden cases)."""
     return _evaluate(NUMBER, TITLE, list(FUNCTIONS),
                      _stop_parts(stalled, stop_rule_step, seed))
-
-
-def check(stalled, stop_rule_step):
-    """Exercise 5: check stalled(delta_theta, lengths, fraction) and stop_rule_step(...)."""
-    _report(verdict(stalled, stop_rule_step))

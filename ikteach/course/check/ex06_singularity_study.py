@@ -13,7 +13,7 @@ from ...core.dls import dls_step as _ref_dls
 from ...core.jt import jt_step as _ref_jt
 from ...core.pinv import pinv_step as _ref_pinv
 from ...core.solve import solve as _solve
-from .verdicts import (SOLVE_LIMIT, _Fail, _Part, _call, _check_callable, _evaluate, _report)
+from .verdicts import (SOLVE_LIMIT, _Fail, _Part, _call, _check_callable, _evaluate)
 
 NUMBER = 6
 CHECK_NAME = "singularity_study"
@@ -118,8 +118,3 @@ def verdict(study, seed=None):
     values read off the notebook's own runs (fixed arm and targets), so there are no hidden
     cases - the instructor reads the code and the written answer."""
     return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _study_parts(study))
-
-
-def check(study):
-    """Exercise 6: check study(jt_step, pinv_step, dls_step) -> dict of answers, by value."""
-    _report(verdict(study))

@@ -8,7 +8,7 @@ import numpy as np
 
 from ...core.priority import priority_step as _ref_step
 from .verdicts import (_Case, _Fail, _Part, _as_array, _call, _check_callable, _close, _evaluate,
-                       _fmt, _mismatch, _report, _rng, _shape_message)
+                       _fmt, _mismatch, _rng, _shape_message)
 
 NUMBER = 7
 CHECK_NAME = "priority_step"
@@ -247,8 +247,3 @@ def verdict(priority_step, seed=None):
     """Verdict for exercise 7 without printing (`seed`: the grader's hidden cases)."""
     return _evaluate(NUMBER, TITLE, list(FUNCTIONS),
                      _priority_parts(priority_step, "priority_step", seed))
-
-
-def check(priority_step):
-    """Exercise 7: check priority_step(J1, e1, J2, e2, damping) against ik.priority_step."""
-    _report(verdict(priority_step))

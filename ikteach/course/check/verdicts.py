@@ -240,10 +240,6 @@ def _evaluate(number, name, function_names, parts):
                    f"{title}: {score:g}/{total:g} - {first_failure}\n  parts: {marks}", results)
 
 
-def _report(verdict):
-    print(verdict.message)
-
-
 def _check_callable(fn, name):
     if not callable(fn):
         raise _Fail(f"expected your function `{name}`, got {type(fn).__name__} {fn!r:.40}")

@@ -4,10 +4,9 @@ instructor to judge) and one feedback file per student. Every text is printable 
 (grading/submissions.text), whatever the file names and notebooks held."""
 import csv
 
+from ..check.registry import NUMBERS as EXERCISE_NUMBERS
+from ..check.verdicts import POINTS
 from .submissions import text
-
-EXERCISE_NUMBERS = range(1, 8)
-POINTS = 10
 
 
 def _feedback_text(student, results):

@@ -7,15 +7,16 @@ stops before writing a CSV of wrong zeros.
 """
 
 SETUP = "import numpy as np\nimport ikteach as ik\n"
+# written unlike a student's usual answer (einsum, a conditional expression), so that its
+# fingerprint in grades.csv's `copied` column points at a copy of it, not at a common answer;
+# the sandbox's copy of ikteach does not hold this file (grading/reference.py)
 GOOD = '''\
 def jt_step(J, e):
-    J, e = np.asarray(J), np.asarray(e)
-    g = J.T @ e
-    v = J @ g
-    vv = v @ v
-    if vv == 0:
-        return np.zeros(J.shape[1])
-    return (e @ v / vv) * g
+    J, e = np.asarray(J, dtype=float), np.asarray(e, dtype=float)
+    grad = np.einsum("ij,i->j", J, e)
+    moved = np.einsum("ij,j->i", J, grad)
+    num, den = float(np.dot(e, moved)), float(np.dot(moved, moved))
+    return grad * (num / den) if den > 0.0 else np.zeros_like(grad)
 '''
 WRAPPER = "def jt_step(J, e):\n    return ik.jt_step(J, e)\n"
 
