@@ -17,6 +17,7 @@ docstrings, file names and line numbers, compared with the references' and the s
 """
 import ast
 import compileall
+import dis
 import hashlib
 import importlib
 import os
@@ -87,16 +88,32 @@ def sandbox_copy(package, dest, references=(), exercise=None):
 
 # --- fingerprints: copied code, reported ---------------------------------------------------
 
+def _operations(code):
+    """What `code` does, instruction by instruction: the operations, their numbers and
+    operators, not the names they load (nor how a call on a module is spelled: a cell that
+    imports `np` itself compiles `np.f()` other than one that does not)."""
+    for ins in dis.get_instructions(code):
+        if ins.opname == "CACHE":
+            continue
+        name = "LOAD_ATTR" if ins.opname == "LOAD_METHOD" else ins.opname
+        if name == "LOAD_CONST":
+            const = ins.argval
+            if isinstance(const, types.CodeType):
+                yield f"code {fingerprint(const)}"
+            elif isinstance(const, (int, float, complex, tuple)) and not isinstance(const, bool):
+                yield f"const {const!r}"
+            else:
+                yield name
+        elif name in ("BINARY_OP", "COMPARE_OP", "CALL", "PRECALL", "CALL_FUNCTION_EX"):
+            yield f"{name} {ins.argrepr or ins.arg}"
+        else:
+            yield name
+
+
 def fingerprint(code):
-    """A hash of what `code` does: its bytecode, its numbers and its nested functions', not
-    its names, docstring, file or line numbers (a copy with renamed variables matches)."""
-    digest = hashlib.sha256(code.co_code)
-    for const in code.co_consts:
-        if isinstance(const, types.CodeType):
-            digest.update(fingerprint(const).encode())
-        elif isinstance(const, (int, float, complex, tuple)) and not isinstance(const, bool):
-            digest.update(repr(const).encode())
-    return digest.hexdigest()[:24]
+    """A hash of what `code` does (_operations), not of its names, docstring, file or line
+    numbers: a copy with renamed variables matches."""
+    return hashlib.sha256("\n".join(_operations(code)).encode()).hexdigest()[:24]
 
 
 def _codes(code):
