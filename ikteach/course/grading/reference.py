@@ -150,42 +150,66 @@ def reference_fingerprints(references, extra_sources=()):
     return out
 
 
-def held_code(namespace, depth=3):
-    """The code objects the values of `namespace` hold: functions, their wrappers, closures,
-    defaults and globals they name, classes' methods, bare code objects (in the worker)."""
-    seen, out = set(), []
+def _reachable(roots, depth=4):
+    """Every object `roots` lead to through what their code names: functions and their
+    wrappers (jit, partial, bound methods, a callable's __call__), the globals and module
+    attributes (ik.jacobian) their code names, their defaults and closures, classes' methods,
+    containers' items. ikteach's own functions are reached, not entered."""
+    seen = {}
 
     def visit(obj, left):
-        if id(obj) in seen or left < 0:
+        if obj is None or id(obj) in seen or left < 0:
             return
-        seen.add(id(obj))
-        if isinstance(obj, types.CodeType):
-            out.append(obj)
-        elif isinstance(obj, (types.FunctionType, types.MethodType)):
-            fn = getattr(obj, "__func__", obj)
-            out.append(fn.__code__)
-            for cell in fn.__closure__ or ():
-                visit(cell.cell_contents if cell.cell_contents is not None else None, left - 1)
-            for value in list(fn.__defaults__ or ()) + [fn.__globals__.get(n)
-                                                        for n in fn.__code__.co_names]:
-                visit(value, left - 1)
-        elif isinstance(obj, type):
-            for value in list(vars(obj).values()):
-                visit(getattr(value, "__func__", value), left - 1)
+        seen[id(obj)] = obj
+        inner = [getattr(obj, a, None) for a in ("__wrapped__", "__func__", "func")]
+        if isinstance(obj, type):
+            inner += list(vars(obj).values())
         elif isinstance(obj, (list, tuple, dict)):
-            for value in list(obj.values() if isinstance(obj, dict) else obj)[:100]:
-                visit(value, left - 1)
-        if getattr(obj, "__wrapped__", None) is not None:
-            visit(obj.__wrapped__, left - 1)
-        if getattr(obj, "func", None) is not None and callable(obj):
-            visit(obj.func, left - 1)
+            inner += list(obj.values() if isinstance(obj, dict) else obj)[:100]
+        elif isinstance(obj, types.FunctionType):
+            if not str(obj.__module__).startswith("ikteach"):
+                names = {n for code in _codes(obj.__code__) for n in code.co_names}
+                values = [obj.__globals__.get(n) for n in names]
+                inner += values + [vars(v).get(n) for v in values  # not a module's __getattr__
+                                   if isinstance(v, types.ModuleType) for n in names]
+                inner += list(obj.__defaults__ or ()) + [_content(c) for c in obj.__closure__ or ()]
+        elif not isinstance(obj, types.ModuleType):
+            inner.append(getattr(type(obj), "__call__", None))
+        for value in inner:
+            visit(value, left - 1)
 
-    for value in list(namespace.values()):
+    for root in roots:
         try:
-            visit(value, depth)
-        except Exception:  # noqa: BLE001 - a student's odd object: its code is not visited
+            visit(root, depth)
+        except Exception:  # noqa: BLE001 - a student's odd object: not entered
             continue
-    return out
+    return list(seen.values())
+
+
+def _content(cell):
+    try:
+        return cell.cell_contents
+    except ValueError:  # an empty cell
+        return None
+
+
+def held_code(namespace):
+    """The code objects a namespace holds (in the worker, after the student's statements):
+    its functions' and those they reach, and bare code objects (a marshalled blob)."""
+    found = _reachable(list(namespace.values()))
+    return ([o.__code__ for o in found if isinstance(o, types.FunctionType)]
+            + [o for o in found if isinstance(o, types.CodeType)])
+
+
+def reached(functions, references):
+    """The references ("ikteach.core.x:fn") that `functions` reach by what their code names
+    (for the instant check: in the grader's sandbox those are stubs that raise)."""
+    targets = {}
+    for ref in references:
+        module, name = ref.split(":")
+        obj = getattr(importlib.import_module(module), name)
+        targets.update({id(obj): ref, id(_python_function(obj)): ref})
+    return sorted({targets[id(o)] for o in _reachable(functions) if id(o) in targets})
 
 
 def copied(found, references):
@@ -195,42 +219,3 @@ def copied(found, references):
                     for h, name in found.items() if h in references})
     return lines[:5]
 
-
-def reached(functions, references):
-    """The references ("ikteach.core.x:fn") that `functions` call by name: bound to them, or
-    naming them as a global, a module attribute (ik.jacobian), a default, in a closure or in
-    a function they call (for the instant check: the grader's copy has them as stubs)."""
-    targets = {}
-    for ref in references:
-        module, name = ref.split(":")
-        obj = getattr(importlib.import_module(module), name)
-        targets.update({id(obj): ref, id(_python_function(obj)): ref})
-    found, seen = set(), set()
-
-    def visit(obj, left):
-        if id(obj) in targets:
-            found.add(targets[id(obj)])
-        if left < 0 or id(obj) in seen:
-            return
-        seen.add(id(obj))
-        fn = _python_function(getattr(obj, "__func__", getattr(obj, "func", obj)))
-        if fn is None:
-            call = getattr(type(obj), "__call__", None)
-            fn = call if isinstance(call, types.FunctionType) else None
-        if fn is None or str(fn.__module__).startswith("ikteach"):
-            return
-        names = {n for code in _codes(fn.__code__) for n in code.co_names}
-        values = [fn.__globals__.get(n) for n in names]
-        values += [getattr(v, n, None) for v in values if isinstance(v, types.ModuleType)
-                   for n in names]
-        values += list(fn.__defaults__ or ()) + [c.cell_contents for c in fn.__closure__ or ()
-                                                 if c.cell_contents is not None]
-        for value in values:
-            visit(value, left - 1)
-
-    for function in functions:
-        try:
-            visit(function, 4)
-        except Exception:  # noqa: BLE001 - an odd object: nothing found in it
-            continue
-    return sorted(found)
