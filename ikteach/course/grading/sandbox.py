@@ -221,6 +221,8 @@ class Sandbox:
                                        Path(work), pid1, package) + list(argv)
 
     def environment(self, work, package=None):
+        """The bare environment of a run; `package`: the copy of ikteach it imports (without
+        bubblewrap, which shows the copy in ikteach's own place)."""
         home = Path(work) / "home"
         (home / "tmp").mkdir(parents=True, exist_ok=True)
         env = {"PATH": f"{Path(sys.executable).parent}:/usr/local/bin:/usr/bin:/bin",
@@ -236,7 +238,8 @@ class Sandbox:
         cgroup = self._cgroup_dir()
         package = self.package_for(exercise)
         proc = subprocess.Popen(self.command(argv, work, cgroup, pid1, package), cwd=work,
-                                env=self.environment(work, package), **popen)
+                                env=self.environment(work, None if self.bwrap else package),
+                                **popen)  # bubblewrap shows the copy where ikteach lies
         return Process(proc, cgroup)
 
 
