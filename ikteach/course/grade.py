@@ -14,10 +14,14 @@ student's exercise notebooks (NN_name.ipynb, as handed out). For each notebook:
 2. the student's functions are taken from the notebook's source (top-level imports,
    definitions and assignments, by the AST) into a second sandboxed process, and ik.check runs
    in the grader's own process, calling them there through a pipe (each call under its time
-   limit). So nothing a notebook does to modules, builtins, stdout or files changes a score.
-   In that process ikteach's own answer to the exercise raises, the checker cannot be imported,
-   and a graded name that is not a function written in the notebook gets 0 (grading/own_code.py).
-Both processes are fresh children of a fork server (grading/forkserver.py: one per sandbox and
+   limit), on hidden cases: the instant check's kinds with numbers drawn from a seed at
+   grading time (logged; --seed repeats a run). So nothing a notebook does to modules,
+   builtins, stdout or files changes a score. A graded name that is not a function written
+   in the notebook gets 0 (grading/own_code.py).
+Both processes see a copy of ikteach in which the exercise's reference answers are stubs that
+raise, without the checker and the self-check (grading/reference.py: what the grader
+guarantees and what it only reports - code copied from ikteach, in grades.csv's `copied`).
+They are fresh children of a fork server (grading/forkserver.py: one per sandbox, exercise and
 grading process, Python, JAX and ikteach imported once), which no student code ever ran in;
 after each, every process of the sandbox but the server is killed and what they wrote removed,
 so no notebook starts from a state another one touched.
@@ -30,9 +34,9 @@ in the CSV's `notes`. Each notebook's cells get --timeout seconds and its checks
 --grade-timeout, both enforced from outside the student's process (the fork server kills every
 process of the job; the grader kills the whole sandbox if the server does not answer).
 
-Writes one CSV row per student (ex1..ex7, total, sandbox, notes) and a feedback file per student
-(FEEDBACK/<student>.txt, by default a `feedback` folder next to the CSV); the log starts with
-what the sandbox enforces and what it cannot on this machine.
+Writes one CSV row per student (ex1..ex7, total, sandbox, notes, copied) and a feedback file
+per student (FEEDBACK/<student>.txt, by default a `feedback` folder next to the CSV); the log
+starts with what the sandbox enforces and what it cannot on this machine.
 """
 import argparse
 import csv
