@@ -1,7 +1,8 @@
 """Grade the students' exercise notebooks.
 
     python -m ikteach.course.grade SUBMISSIONS_DIR --out grades.csv [--feedback DIR] [--timeout S]
-                            [--grade-timeout S] [--jobs N] [--memory-mb M] [--no-sandbox]
+                            [--grade-timeout S] [--jobs N] [--memory-mb M] [--seed N]
+                            [--no-sandbox]
     python -m ikteach.course.grade --gradescope OUT.zip      (a Gradescope autograder bundle)
 
 SUBMISSIONS_DIR holds one folder per student (the folder name is the student), each with that
