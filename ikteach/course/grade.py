@@ -191,15 +191,16 @@ def _result(name, number=None, message=""):
 
 def grade_book(name, book, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT,
                sandbox=None, run_cells=True, seed=None):
-    """Grade one notebook (a dict) on the hidden cases drawn from `seed` (None: the instant
-    check's); returns a dict: file, exercise, score, max, status, message, notes (what went
-    wrong on the way), answer (the written answer, if any), copied (functions whose code is
-    ikteach's answer: for the instructor)."""
+    """Grade one notebook (a dict) on the hidden cases drawn from `seed` (None: a fresh secret
+    one - never the instant check's public cases); returns a dict: file, exercise, score, max,
+    status, message, notes (what went wrong on the way), answer (the written answer, if any),
+    copied (functions whose code is ikteach's answer: for the instructor), seed."""
     from .grading.sandbox import Sandbox
 
     sandbox = sandbox or Sandbox()  # raises SandboxUnavailable where there is none
     number = exercise_number(name, book)
     result = _result(name, number)
+    result["seed"] = seed = secrets.randbits(63) if seed is None else int(seed)
     if number is None:
         result["message"] = ("not an exercise notebook (no ikteach exercise number in its "
                              "metadata or name)")

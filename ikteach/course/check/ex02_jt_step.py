@@ -43,7 +43,7 @@ def _hidden_hand(rng):
             (np.diag([a, b, c])[:2], rng.normal(size=2).round(3), "regular"),
             (rng.normal(size=(2, n)).round(3), np.zeros(2), "zero"),
             (np.vstack([rng.normal(size=n).round(3), np.zeros(n)]), np.array([0.0, c]), "zero"),
-            (np.zeros((2, n)), rng.normal(size=2).round(3), "zero")]
+            (np.zeros((2, n + 1)), rng.normal(size=2).round(3), "zero")]  # not square
 
 
 def _jt_cases(seed=None):

@@ -28,7 +28,7 @@ def _hidden_hand(rng):
     a, b, c = rng.uniform(0.5, 3.0, 3).round(3)
     lams = rng.uniform(0.1, 0.9, 3).round(3)
     return [(np.array([[0.0, 0.0], [a, b]]), rng.normal(size=2).round(3), lams[0], "singular J"),
-            (np.zeros((2, int(rng.integers(2, 5)))), rng.normal(size=2).round(3), lams[1],
+            (np.zeros((2, int(rng.integers(3, 5)))), rng.normal(size=2).round(3), lams[1],
              "zero J"),
             (c * np.eye(2), rng.normal(size=2).round(3), lams[2], "")]
 
