@@ -107,3 +107,21 @@ def test_a_memorised_stop_count_earns_only_the_rule_hidden():
 
     assert check.stop_rule_verdict(stalled, stop_rule_step).score == 10
     assert all(check.stop_rule_verdict(stalled, stop_rule_step, seed=s).score == 5 for s in SEEDS)
+
+
+def notebook_functions(path):
+    namespace = {}
+    for cell, source in code_cells(json.loads(path.read_text())):
+        if not only_checks(source):
+            exec(compile(source, f"<cell {cell}>", "exec"), namespace)
+    return namespace
+
+
+@pytest.mark.parametrize("student, number, marks", [
+    ("sign_error", 1, 6), ("fixed_alpha", 2, 7), ("no_cutoff", 3, 7),
+    ("lambda_not_squared", 4, 2), ("exception", 2, 0)])
+def test_a_wrong_answer_costs_the_same_on_every_draw(student, number, marks):
+    """tests/submissions' wrong answers: the marks test_grade expects, whatever the seed."""
+    namespace = notebook_functions(next((ROOT / "tests" / "submissions" / student).glob("*.ipynb")))
+    for seed in (None,) + SEEDS + (7, 8, 9):
+        assert check.grade(number, namespace, seed=seed).score == marks, seed
