@@ -311,6 +311,8 @@ def grade_all(submissions, out, feedback=None, timeout=NOTEBOOK_TIMEOUT, jobs=1,
                 notes[name].append(f"the folder could not be read: {exc.strerror or exc}")
                 continue
             jobs_list += [(name, path, why) for _, path, why in books]
+        # by exercise: each exercise's fork server (its own copy of ikteach) starts once
+        jobs_list.sort(key=lambda job: exercise_number(job[1], None) or 0)
         outcomes = _grade_jobs(jobs_list, jobs, timeout, grade_timeout, sandbox, seed)
     finally:
         sandbox.close()

@@ -34,6 +34,8 @@ def server_for(sandbox, exercise=None):
     """This process's running server for `sandbox` and `exercise` (whose copy of ikteach it
     sees: reference.py), a new one if it has none or it broke."""
     key = (str(sandbox.work_root), exercise)
+    for other in [k for k in _servers if k[0] == key[0] and k != key]:
+        _servers.pop(other).stop()  # one server per sandbox at a time: each holds JAX
     server = _servers.get(key)
     if server is None or not server.alive():
         _servers[key] = server = Server(sandbox, exercise)
