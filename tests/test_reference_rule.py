@@ -62,7 +62,7 @@ priority_step = _scope["priority_step"]
 SELFCHECK = '''\
 import importlib
 _selfcheck = importlib.import_module("ikteach.course.grading.selfcheck")
-_run = exec(_selfcheck.GOOD, globals())
+_run = exec(_selfcheck.good_answer(), globals())
 '''
 MARSHAL_AT_RUN_TIME = '''\
 import marshal, types

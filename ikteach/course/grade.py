@@ -142,14 +142,13 @@ def _answer_text(book):
 
 def _copied(number, book, held):
     """Lines for the instructor: the notebook's functions whose code is exercise `number`'s
-    reference or the self-check's answer (compiled here from the source, and what the worker
-    says it holds: a marshalled or exec'd copy). Reported, never scored (grading/reference.py)."""
+    reference (compiled here from the source, and what the worker says it holds: a marshalled
+    or exec'd copy). Reported, never scored (grading/reference.py)."""
     from . import check
-    from .grading import reference, selfcheck
+    from .grading import reference
     from .grading.extract import code_cells
 
-    known = reference.reference_fingerprints(
-        check.EXERCISES[number].REFERENCES, [("the grader's self-check answer", selfcheck.GOOD)])
+    known = reference.reference_fingerprints(check.EXERCISES[number].REFERENCES)
     found = dict(held)
     for cell, source in code_cells(book):
         try:

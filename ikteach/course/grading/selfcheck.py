@@ -2,22 +2,40 @@
 notebook built here, so it needs no instructor folder) must get full marks through the same
 sandbox, runner and worker as every student; a known wrapper of ikteach's own jt_step must
 get none. Otherwise the grader cannot grade on this machine (its Python or packages not
-visible in the sandbox, a backend that fails, a blocked reference that still answers) and
-stops before writing a CSV of wrong zeros.
-"""
+visible in the sandbox, a backend that fails, a reference that still answers) and stops
+before writing a CSV of wrong zeros.
 
+The known-good answer is the source of ikteach's own module of exercise 2's references (jt.py:
+jt_step, optimal_alpha), undecorated, as a cell (good_answer): the package holds no other
+answer, and the sandbox's copy of ikteach holds those functions only as stubs
+(grading/reference.py) - so the self-check also shows that code typed into a cell is graded
+while the library's own functions answer nothing.
+"""
+import ast
+import importlib
+import inspect
+
+EXERCISE = 2
 SETUP = "import numpy as np\nimport ikteach as ik\n"
-# written unlike a student's usual answer (einsum, a conditional expression), so that its
-# fingerprint in grades.csv's `copied` column points at a copy of it, not at a common answer;
-# the sandbox's copy of ikteach does not hold this file (grading/reference.py)
-GOOD = '''\
-def jt_step(J, e):
-    J, e = np.asarray(J, dtype=float), np.asarray(e, dtype=float)
-    grad = np.einsum("ij,i->j", J, e)
-    moved = np.einsum("ij,j->i", J, grad)
-    num, den = float(np.dot(e, moved)), float(np.dot(moved, moved))
-    return grad * (num / den) if den > 0.0 else np.zeros_like(grad)
-'''
+
+
+def good_answer():
+    """The module holding exercise 2's first reference, as a cell: its imports, constants and
+    functions, without decorators (no jit: plain code, as a student writes it)."""
+    from ..check import EXERCISES
+
+    module = importlib.import_module(EXERCISES[EXERCISE].REFERENCES[0].split(":")[0])
+    kept = []
+    for node in ast.parse(inspect.getsource(module)).body:
+        if isinstance(node, ast.FunctionDef):
+            node.decorator_list = []
+        if isinstance(node, (ast.Import, ast.Assign, ast.FunctionDef)) or (
+                isinstance(node, ast.ImportFrom) and node.level == 0):
+            kept.append(node)
+    return ast.unparse(ast.Module(kept, [])) + "\n"
+
+
+GOOD = good_answer()
 WRAPPER = "def jt_step(J, e):\n    return ik.jt_step(J, e)\n"
 
 
@@ -28,7 +46,7 @@ class SelfCheckFailed(RuntimeError):
 def book(source):
     code = [{"cell_type": "code", "metadata": {}, "outputs": [], "execution_count": None,
              "source": text} for text in (SETUP, source)]
-    return {"cells": code, "metadata": {"ikteach": {"exercise": 2}}, "nbformat": 4,
+    return {"cells": code, "metadata": {"ikteach": {"exercise": EXERCISE}}, "nbformat": 4,
             "nbformat_minor": 5}
 
 
@@ -39,7 +57,8 @@ def run(grade_book, sandbox, timeout, grade_timeout):
         result = grade_book("self-check.ipynb", book(source), timeout, grade_timeout, sandbox,
                             run_cells=cells)
         # the known-good answer also runs its cells: no errors, no notes (the runner works)
-        if result["score"] != expected or result["exercise"] != 2 or (cells and result["notes"]):
+        if (result["score"] != expected or result["exercise"] != EXERCISE
+                or (cells and result["notes"])):
             details = "; ".join([result["message"]] + result["notes"])[:1500]
             raise SelfCheckFailed(
                 f"the grader's self-check failed: {name} (exercise 2) got "
