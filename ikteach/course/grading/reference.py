@@ -21,6 +21,7 @@ import dis
 import hashlib
 import importlib
 import os
+import py_compile
 import shutil
 import tempfile
 import types
@@ -55,21 +56,27 @@ def stub_source(source, names, exercise):
     return ast.unparse(tree) + "\n"
 
 
-def sandbox_copy(package, dest, references=(), exercise=None):
+def sandbox_copy(package, dest, references=(), exercise=None, base=None):
     """The folder `dest` (made once: a finished copy is reused), a copy of ikteach's
-    `package` without LEFT_OUT, its `references` ("ikteach.core.x:fn") stubbed, compiled."""
+    `package` without LEFT_OUT, its `references` ("ikteach.core.x:fn") stubbed, compiled.
+    `base`: such a copy without stubs to start from (its compiled files are reused; those of
+    the stubbed modules are removed and made again from the stubs)."""
     dest = Path(dest)
     if dest.is_dir():
         return dest
     staging = Path(tempfile.mkdtemp(prefix=".copy-", dir=dest.parent)) / "ikteach"
-    shutil.copytree(package, staging, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
-    for left_out in LEFT_OUT:
-        path = staging / left_out
-        if path.is_dir():
-            shutil.rmtree(path)
-            path.mkdir()  # an empty folder: the sandbox lays a tmpfs over it
-        else:
-            path.unlink(missing_ok=True)
+    if base is None:
+        shutil.copytree(package, staging, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+        for left_out in LEFT_OUT:
+            path = staging / left_out
+            if path.is_dir():
+                shutil.rmtree(path)
+                path.mkdir()  # an empty folder: the sandbox lays a tmpfs over it
+            else:
+                path.unlink(missing_ok=True)
+        compileall.compile_dir(str(staging), quiet=2, ddir=str(package))
+    else:
+        shutil.copytree(base, staging)
     by_module = {}
     for ref in references:
         module, name = ref.split(":")
@@ -78,7 +85,9 @@ def sandbox_copy(package, dest, references=(), exercise=None):
         path = staging.joinpath(*module.split(".")[1:]).with_suffix(".py")
         path.write_text(stub_source(path.read_text(encoding="utf-8"), names, exercise),
                         encoding="utf-8")
-    compileall.compile_dir(str(staging), quiet=2, ddir=str(package))
+        for compiled in path.parent.glob(f"__pycache__/{path.stem}.*.pyc"):
+            compiled.unlink()  # the reference's own code: not left as a file
+        py_compile.compile(str(path), dfile=str(package.joinpath(*path.relative_to(staging).parts)))
     try:
         os.rename(staging, dest)
     except OSError:  # another grading process made it first

@@ -202,10 +202,12 @@ class Sandbox:
         from ..check import EXERCISES
         from .reference import sandbox_copy
 
-        references = EXERCISES[exercise].REFERENCES if exercise is not None else ()
         folder = self.work_root / f"package-{exercise or 0}"
         folder.mkdir(exist_ok=True)
-        return sandbox_copy(self.package, folder / "ikteach", references, exercise)
+        if exercise is None:
+            return sandbox_copy(self.package, folder / "ikteach")
+        return sandbox_copy(self.package, folder / "ikteach", EXERCISES[exercise].REFERENCES,
+                            exercise, base=self.package_for(None))
 
     def command(self, argv, work, cgroup, pid1=False, package=None):
         """The full command line: launcher (limits), then bwrap (if any), then argv (`pid1`:
