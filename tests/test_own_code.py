@@ -163,3 +163,19 @@ def test_only_functions_written_in_the_notebook_count_as_own(verdicts, definitio
     answer = verdicts[repr(definition)]
     assert (answer == "{}") == own, answer
     assert "missing" not in answer
+
+
+def test_no_file_of_the_copy_holds_the_references_code(tmp_path):
+    """Sources and compiled files alike (the copy is made from a compiled base copy): no code
+    object in them is ikteach's jt_step or optimal_alpha; the checker's folder is empty."""
+    (tmp_path / "base").mkdir()
+    (tmp_path / "ex2").mkdir()
+    base = reference.sandbox_copy(PACKAGE, tmp_path / "base" / "ikteach")
+    copy = reference.sandbox_copy(PACKAGE, tmp_path / "ex2" / "ikteach",
+                                  check.EXERCISES[2].REFERENCES, 2, base=base)
+    codes = [compile(p.read_text(), str(p), "exec") for p in copy.rglob("*.py")]
+    codes += [marshal.loads(p.read_bytes()[16:]) for p in copy.rglob("*.pyc")]
+    assert len(codes) > 100 and list((copy / "course" / "check").iterdir()) == []
+    assert reference.copied(reference.fingerprints(codes), known(2)) == []
+    assert reference.copied(reference.fingerprints(
+        [marshal.loads(p.read_bytes()[16:]) for p in base.rglob("jt.*.pyc")]), known(2))
