@@ -53,8 +53,10 @@ def not_yet(*args):
 def test_correct_functions_pass():
     assert check.jacobian_verdict(planar_jacobian).score == 10
     assert check.jt_step_verdict(jt_step).passed
-    assert check.pinv_step_verdict(lambda J, e, r: np.asarray(ik.pinv_step(J, e, r))).passed
-    assert check.dls_step_verdict(ik.dls_step, ik.dls_step_normal).passed
+    # ikteach's own answers pass the checks themselves (ik.check.<name>_verdict gives them 0,
+    # as the grader does: test_a_wrapper_of_ikteachs_answer_is_told_what_the_grader_gives)
+    assert check.ex03_pinv_step.verdict(lambda J, e, r: np.asarray(ik.pinv_step(J, e, r))).passed
+    assert check.ex04_dls_step.verdict(ik.dls_step, ik.dls_step_normal).passed
 
 
 @pytest.mark.parametrize("wrong, score, words", [
@@ -118,7 +120,8 @@ def test_pinv_without_a_guard_for_a_zero_jacobian():
         return Vt.T @ (inv * (U.T @ e))
     verdict = check.pinv_step_verdict(unguarded)
     assert verdict.score == 8 and "no guard for sigma_max = 0" in verdict.message
-    assert verdict.parts == {"regular": True, "cut-off": True, "J = 0": False}
+    assert verdict.parts == {"regular": True, "sign": True, "small sigma dropped": True,
+                             "sigma_max = 0 guard": False}
 
 
 def test_pinv_absolute_cutoff():
@@ -130,9 +133,61 @@ def test_pinv_absolute_cutoff():
     assert verdict.score == 7 and "must be relative" in verdict.message
 
 
+def pinv_fixed_cutoff(cutoff):
+    """A pinv_step that ignores rcond: a fixed relative cut-off (np.linalg.pinv's is 1e-15)."""
+    def step(J, e, rcond):
+        U, s, Vt = np.linalg.svd(J, full_matrices=False)
+        keep = (s >= cutoff * s.max(initial=0.0)) & (s > 0)
+        return Vt.T @ (np.where(keep, 1 / np.where(keep, s, 1), 0) * (U.T @ e))
+    return step
+
+
+@pytest.mark.parametrize("seed", [None, 1, 2, 3])
+@pytest.mark.parametrize("cutoff", [1e-1, 1e-2, 1e-3, 1e-4, 1e-5])
+def test_pinv_ignoring_rcond_loses_the_cutoff_points(seed, cutoff):
+    """Cases with sigma_min / sigma_max between 1e-5 and 0.1 and rcond on either side: a
+    fixed cut-off keeps what rcond drops or drops what it keeps - in the instant check and in
+    every draw of the hidden cases."""
+    verdict = check.pinv_step_verdict(pinv_fixed_cutoff(cutoff), seed=seed)
+    assert verdict.score == 7 and not verdict.parts["small sigma dropped"], verdict.message
+    assert "ignores `rcond`: on every case it drops what a fixed relative cut-off of" \
+        in verdict.message, verdict.message  # (1e-2 and 1e-3 drop the same on some draws)
+
+
+def test_np_linalg_pinv_is_told_it_has_no_cutoff():
+    verdict = check.pinv_step_verdict(lambda J, e, rcond: np.linalg.pinv(J) @ e)
+    assert verdict.score == 7 and "no cut-off" in verdict.message
+    assert "np.linalg.pinv(J) keeps every sigma_i >= 1e-15 sigma_max" in verdict.message
+
+
+def test_pinv_with_u_and_v_swapped_gets_a_hint_not_only_numpys_error():
+    def swapped(J, e, rcond):
+        U, s, Vt = np.linalg.svd(J, full_matrices=False)
+        keep = (s >= rcond * s[0]) & (s > 0)
+        return U @ (np.where(keep, 1 / np.where(keep, s, 1), 0) * (Vt @ e))
+    verdict = check.pinv_step_verdict(swapped)
+    assert verdict.score == 0, verdict.message
+    assert "mismatch in its core dimension" in verdict.message  # what numpy said, and then
+    assert "hint: J (m x n) = U Sigma V^T" in verdict.message and "U and V swapped?" in verdict.message
+    square = check.ex03_pinv_step.verdict(
+        lambda J, e, r: swapped(J, e, r) if J.shape[0] == J.shape[1]
+        else np.asarray(ik.pinv_step(J, e, r)))
+    assert square.score < 10 and "U and V swapped: delta_theta = V Sigma^+ U^T e" in square.message
+
+
+@pytest.mark.parametrize("seed", [None, 5])
+def test_a_sign_slip_costs_the_same_in_exercises_2_and_3(seed):
+    jt = check.jt_step_verdict(lambda J, e: -jt_step(J, e), seed=seed)
+    pinv = check.ex03_pinv_step.verdict(lambda J, e, r: -np.asarray(ik.pinv_step(J, e, r)),
+                                        seed=seed)
+    assert jt.score == pinv.score == 7, (jt.message, pinv.message)
+    assert "wrong sign" in jt.message and "wrong sign" in pinv.message
+    assert not jt.parts["sign"] and not pinv.parts["sign"]
+
+
 def test_dls_lambda_not_squared_and_partial_credit():
     lam = lambda J, e, l: J.T @ np.linalg.solve(J @ J.T + l * np.eye(J.shape[0]), e)
-    verdict = check.dls_step_verdict(lam, ik.dls_step_normal)
+    verdict = check.ex04_dls_step.verdict(lam, ik.dls_step_normal)
     assert verdict.score == 4 and "missing square on lambda" in verdict.message
     assert "your two forms disagree" not in verdict.message  # the first failure is shown
     assert verdict.parts == {"dls_step": False, "dls_step_normal": True, "agree": False}
@@ -143,7 +198,7 @@ def test_not_implemented_is_not_an_error(capsys):
     out = capsys.readouterr().out
     assert "not yet implemented" in out and "Traceback" not in out
     assert check.dls_step_verdict(not_yet, not_yet).status == "not implemented"
-    half = check.dls_step_verdict(ik.dls_step, not_yet)
+    half = check.ex04_dls_step.verdict(ik.dls_step, not_yet)
     assert half.status == "failed" and half.score == 4
     assert check.singularity_study_verdict(not_yet).status == "not implemented"
 
@@ -197,6 +252,39 @@ def test_singularity_study_answers_checked_by_value():
     assert "'fewest_iterations' is not right" in verdict.message
     assert verdict.parts["smallest_lambda"] is False
     assert "must return a dict" in check.singularity_study_verdict(lambda *a: 3).message
+
+
+def jacobian_from_ikteach(lengths, theta):
+    return np.asarray(ik.jacobian(ik.planar_chain(lengths), theta))
+
+
+@pytest.mark.parametrize("number, functions, reference", [
+    (1, [jacobian_from_ikteach], "ikteach.core.jacobian.jacobian"),
+    (1, [lambda L, t: ik.jacobian(ik.planar_chain(L), t)], "ikteach.core.jacobian.jacobian"),
+    (2, [ik.jt_step], "ikteach.core.jt.jt_step"),
+    (3, [lambda J, e, r: ik.pinv_step(J, e, r)], "ikteach.core.pinv.pinv_step"),
+    (4, [ik.dls_step, lambda J, e, l: np.asarray(ik.dls_step_normal(J, e, l))],
+     "ikteach.core.dls.dls_step, ikteach.core.dls.dls_step_normal"),
+    (7, [lambda *a: ik.priority_step(*a)], "ikteach.core.priority.priority_step"),
+])
+def test_a_wrapper_of_ikteachs_answer_is_told_what_the_grader_gives(number, functions,
+                                                                     reference, capsys):
+    """The instant check says what the grader will: 0, because the grader's sandbox has
+    ikteach's own answer only as a stub that raises (grading/reference.py)."""
+    module = check.EXERCISES[number]
+    assert module.verdict(*functions).passed  # right answers, but not the student's own
+    verdict = getattr(check, f"{module.CHECK_NAME}_verdict")(*functions)
+    assert verdict.score == 0 and f"calls ikteach's own answer to this exercise ({reference})" \
+        in verdict.message, verdict.message
+    assert "raise ReferenceBlocked, so this gets 0/10 there" in verdict.message
+    getattr(check, module.CHECK_NAME)(*functions)
+    assert capsys.readouterr().out.strip() == verdict.message
+
+
+def test_other_ikteach_functions_are_fine_in_the_instant_check():
+    assert check.jacobian_verdict(planar_jacobian).passed  # ik.joint_positions: allowed
+    other = check.pinv_step_verdict(lambda J, e, r: -np.asarray(ik.dls_step(J, e, 0.0)))
+    assert "own code" not in other.parts, other.message  # checked like any answer, not refused
 
 
 def test_grade_finds_functions_in_a_namespace():

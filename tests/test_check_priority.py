@@ -98,7 +98,7 @@ def test_correct_step_gets_full_marks():
 
 
 def test_module_step_gets_full_marks():
-    verdict = ik.check.priority_step_verdict(lambda *a: np.asarray(ik.priority_step(*a)))
+    verdict = ik.check.ex07_priority_step.verdict(lambda *a: np.asarray(ik.priority_step(*a)))
     assert verdict.passed and verdict.score == 10, verdict.message
 
 
@@ -118,6 +118,34 @@ def test_each_mistake_is_diagnosed(wrong, says):
     assert verdict.status == "failed" and verdict.score < 10
     assert says in verdict.message, verdict.message
     assert "smallest failing case" in verdict.message
+
+
+def lambda_not_squared(J1, e1, J2, e2, damping):
+    """Both pseudoinverses damped with lambda I instead of lambda^2 I (exercise 4's slip)."""
+    lam = np.sqrt(damping)
+    first = damped(J1, lam) @ e1
+    N1 = projector(J1)
+    return first + N1 @ damped(J2 @ N1, lam) @ (e2 - J2 @ first)
+
+
+def no_damping_at_all(J1, e1, J2, e2, damping):
+    first = np.linalg.pinv(J1) @ e1
+    N1 = projector(J1)
+    return first + N1 @ np.linalg.pinv(J2 @ N1) @ (e2 - J2 @ first)
+
+
+@pytest.mark.parametrize("seed", [None, 3])
+@pytest.mark.parametrize("wrong, says, score", [
+    (lambda_not_squared, "the damping term is lambda^2 I, not lambda I", 5),
+    (no_damping_at_all, "no damping: your step uses exact pseudoinverses for damping > 0", 2),
+])
+def test_wrong_damping_is_named_not_a_disturbed_primary(wrong, says, score, seed):
+    """lambda for lambda^2 keeps the primary (its own damping is wrong, not the projection);
+    no damping at all blows up where J2 N1 is nearly singular, so it loses the primary too."""
+    verdict = ik.check.priority_step_verdict(wrong, seed=seed)
+    assert verdict.score == score and says in verdict.message, verdict.message
+    assert "primary task is disturbed" not in verdict.message
+    assert verdict.parts["no damping"]  # at damping 0 both are the exact step
 
 
 def test_the_solution_form_is_finite_at_zero_damping():

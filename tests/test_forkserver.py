@@ -70,9 +70,18 @@ def look(shared):
 '''
 
 
+GOOD = """\
+def jt_step(J, e):
+    J, e = np.asarray(J), np.asarray(e)
+    g = J.T @ e
+    v = J @ g
+    return np.zeros(J.shape[1]) if v @ v == 0 else (e @ v / (v @ v)) * g
+"""  # numpy's asarray, which the attack replaces
+
+
 def attacked_book(shared, chmod_tmp):
     """Exercise 2's known-good answer, preceded by the attack (in the cells and the checks)."""
-    book = selfcheck.book(selfcheck.GOOD)
+    book = selfcheck.book(GOOD)
     call = f"_done = _attack({shared!r}, {chmod_tmp!r})\n"
     book["cells"].insert(1, dict(book["cells"][0], source=ATTACK + call))
     return book
@@ -87,13 +96,13 @@ def test_what_a_notebook_leaves_does_not_reach_the_next(chmod_tmp):
         sandbox.close()
         pytest.skip("without a sandbox /tmp is the machine's own")
     try:
-        first = servers.server_for(sandbox)
+        first = servers.server_for(sandbox, 2)  # exercise 2's (its copy of ikteach)
         attacked = grade.grade_book("a.ipynb", attacked_book(shared, chmod_tmp), 30, 60, sandbox)
         assert attacked["notes"] == [] and attacked["score"] < 10, attacked  # its own asarray
-        replaced = servers.server_for(sandbox) is not first
-        after = grade.grade_book("b.ipynb", selfcheck.book(selfcheck.GOOD), 30, 60, sandbox)
+        replaced = servers.server_for(sandbox, 2) is not first
+        after = grade.grade_book("b.ipynb", selfcheck.book(GOOD), 30, 60, sandbox)
         assert after["score"] == 10 and after["notes"] == [], after
-        worker = Worker([(1, LOOK)], sandbox).start()
+        worker = Worker([(1, LOOK)], sandbox, exercise=2).start()
         try:
             seen = worker.call("look", [shared])
         finally:

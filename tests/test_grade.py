@@ -190,8 +190,8 @@ HOSTILE = [
     # prints fake grade lines, replaces print, sys.stdout and the display hook: template
     ("forge_output", 2, 0, "not yet implemented"),
     # patches the checks from inside its own function: the checker is not there to import
-    ("patch_in_function", 2, 0, "raised ModuleNotFoundError: ikteach.course.check is not "
-                                "available while grading"),
+    ("patch_in_function", 2, 0, "raised ModuleNotFoundError: No module named "
+                                "'ikteach.course.check."),
     # writes outside its folder (the files are checked below); its function is right
     ("write_outside", 1, 10, "passed, 10/10"),
     ("fork_storm", 2, 10, "passed, 10/10"),
@@ -375,7 +375,7 @@ def test_a_failing_self_check_stops_before_grading_anyone(tmp_path, monkeypatch,
         monkeypatch.setattr(ex02_jt_step, "REFERENCES", ())
         why = "a wrapper of ik.jt_step (exercise 2) got 10/10 (expected 0/10"
     else:  # the cells' jobs end without a report, as when the server cannot run them
-        monkeypatch.setattr(grade, "_run_cells", lambda book, sandbox, timeout: (
+        monkeypatch.setattr(grade, "_run_cells", lambda book, sandbox, timeout, number: (
             [], ["the notebook's run ended in cell 1 (exit status 1)"]))
         why = "a correct jt_step (exercise 2) got 10/10 (expected 10/10, without notes)"
     subs, out = one_student(tmp_path)

@@ -2,6 +2,7 @@
 
     python -m ikteach.course.grade SUBMISSIONS_DIR --out grades.csv [--feedback DIR] [--timeout S]
                             [--grade-timeout S] [--jobs N] [--memory-mb M] [--tmpfs-mb T]
+                            [--seed N]
                             [--no-sandbox]
     python -m ikteach.course.grade --gradescope OUT.zip      (a Gradescope autograder bundle)
 
@@ -15,10 +16,14 @@ student's exercise notebooks (NN_name.ipynb, as handed out). For each notebook:
 2. the student's functions are taken from the notebook's source (top-level imports,
    definitions and assignments, by the AST) into a second sandboxed process, and ik.check runs
    in the grader's own process, calling them there through a pipe (each call under its time
-   limit). So nothing a notebook does to modules, builtins, stdout or files changes a score.
-   In that process ikteach's own answer to the exercise raises, the checker cannot be imported,
-   and a graded name that is not a function written in the notebook gets 0 (grading/own_code.py).
-Both processes are fresh children of a fork server (grading/forkserver.py: one per sandbox and
+   limit), on hidden cases: the instant check's kinds with numbers drawn from a seed at
+   grading time (logged; --seed repeats a run). So nothing a notebook does to modules,
+   builtins, stdout or files changes a score. A graded name that is not a function written
+   in the notebook gets 0 (grading/own_code.py).
+Both processes see a copy of ikteach in which the exercise's reference answers are stubs that
+raise, without the checker and the self-check (grading/reference.py: what the grader
+guarantees and what it only reports - code copied from ikteach, in grades.csv's `copied`).
+They are fresh children of a fork server (grading/forkserver.py: one per sandbox, exercise and
 grading process, Python, JAX and ikteach imported once), which no student code ever ran in;
 after each, every process of the sandbox but the server is killed and what they wrote removed,
 so no notebook starts from a state another one touched.
@@ -31,15 +36,17 @@ in the CSV's `notes`. Each notebook's cells get --timeout seconds and its checks
 --grade-timeout, both enforced from outside the student's process (the fork server kills every
 process of the job; the grader kills the whole sandbox if the server does not answer).
 
-Writes one CSV row per student (ex1..ex7, total, sandbox, notes) and a feedback file per student
-(FEEDBACK/<student>.txt, by default a `feedback` folder next to the CSV); the log starts with
-what the sandbox enforces and what it cannot on this machine.
+Writes one CSV row per student (ex1..ex7, total, sandbox, notes, copied) and a feedback file
+per student (FEEDBACK/<student>.txt, by default a `feedback` folder next to the CSV); the log
+starts with what the sandbox enforces and what it cannot on this machine.
 """
 import argparse
 import csv
+import functools
 import json
 import os
 import re
+import secrets
 import select
 import sys
 import time
@@ -73,12 +80,13 @@ def exercise_number(path, book):
     return None
 
 
-def _run_cells(book, sandbox, timeout):
-    """Run the notebook's cells in the sandbox; (error lines, notes) from the job's report."""
+def _run_cells(book, sandbox, timeout, number):
+    """Run the notebook's cells in the sandbox that grades exercise `number`; (error lines,
+    notes) from the job's report."""
     from .grading.extract import code_cells
     from .grading.servers import server_for
 
-    job = server_for(sandbox).job("cells", timeout, {"cells": code_cells(book)})
+    job = server_for(sandbox, number).job("cells", timeout, {"cells": code_cells(book)})
     report, ended = b"", None
     try:
         deadline = time.monotonic() + timeout + GRACE  # the server kills it at `timeout`
@@ -128,42 +136,66 @@ def _answer_text(book):
     return "\n".join(texts)[:4000]
 
 
-def _check(number, book, sandbox, grade_timeout):
-    """The verdict from ik.check in this process, on the student's functions in a worker."""
+def _copied(number, book, held):
+    """Lines for the instructor: the notebook's functions whose code is exercise `number`'s
+    reference (compiled here from the source, and what the worker says it holds: a marshalled
+    or exec'd copy). Reported, never scored (grading/reference.py)."""
+    from . import check
+    from .grading import reference
+    from .grading.extract import code_cells
+
+    known = reference.reference_fingerprints(check.EXERCISES[number].REFERENCES)
+    found = dict(held)
+    for cell, source in code_cells(book):
+        try:
+            found.update(reference.fingerprints([compile(source, f"<cell {cell}>", "exec")]))
+        except (SyntaxError, ValueError, RecursionError, MemoryError):
+            continue  # not Python: the worker's notes say so
+    return reference.copied(found, known)
+
+
+def _check(number, book, sandbox, grade_timeout, seed=None):
+    """The verdict from ik.check in this process, on the student's functions in a worker
+    (`seed`: the hidden cases' seed), its notes, and what of its code is copied."""
     from . import check
     from .grading.extract import code_cells
     from .grading.remote import ProcessEnded, Worker
 
     module = check.EXERCISES[number]
-    worker = Worker(code_cells(book), sandbox, exercise=number,
-                    references=module.REFERENCES, graded=module.FUNCTIONS, limit=grade_timeout)
+    worker = Worker(code_cells(book), sandbox, exercise=number, graded=module.FUNCTIONS,
+                    limit=grade_timeout)
     try:
         try:
             worker.start()
         except (ProcessEnded, ValueError) as exc:  # died, hung, or answered garbage
-            return None, [f"your code could not be loaded for the checks: {exc}"]
+            return None, [f"your code could not be loaded for the checks: {exc}"], []
+        copied = _copied(number, book, worker.held)
         if worker.foreign:  # a graded name bound to ikteach's (or anyone's) code: no marks
-            return check.registry.refuse(number, " ".join(worker.foreign.values())), worker.notes
+            return (check.registry.refuse(number, " ".join(worker.foreign.values())),
+                    worker.notes, copied)
         namespace = {name: worker.function(name) for name in worker.names}
-        return check.grade(number, namespace), worker.notes
+        return check.grade(number, namespace, seed=seed), worker.notes, copied
     finally:
         worker.end()
 
 
 def _result(name, number=None, message=""):
     return {"file": text(name), "exercise": number, "score": 0.0, "max": float(POINTS),
-            "status": "not graded", "message": message, "notes": [], "answer": ""}
+            "status": "not graded", "message": message, "notes": [], "answer": "", "copied": []}
 
 
 def grade_book(name, book, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT,
-               sandbox=None, run_cells=True):
-    """Grade one notebook (a dict); returns a dict: file, exercise, score, max, status, message,
-    notes (what went wrong on the way), answer (the written answer, if any)."""
+               sandbox=None, run_cells=True, seed=None):
+    """Grade one notebook (a dict) on the hidden cases drawn from `seed` (None: a fresh secret
+    one - never the instant check's public cases); returns a dict: file, exercise, score, max,
+    status, message, notes (what went wrong on the way), answer (the written answer, if any),
+    copied (functions whose code is ikteach's answer: for the instructor), seed."""
     from .grading.sandbox import Sandbox
 
     sandbox = sandbox or Sandbox()  # raises SandboxUnavailable where there is none
     number = exercise_number(name, book)
     result = _result(name, number)
+    result["seed"] = seed = secrets.randbits(63) if seed is None else int(seed)
     if number is None:
         result["message"] = ("not an exercise notebook (no ikteach exercise number in its "
                              "metadata or name)")
@@ -171,8 +203,9 @@ def grade_book(name, book, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT
     started = time.monotonic()
     try:
         result["answer"] = _answer_text(book)
-        errors, notes = _run_cells(book, sandbox, timeout) if run_cells else ([], [])
-        verdict, check_notes = _check(number, book, sandbox, grade_timeout)
+        errors, notes = _run_cells(book, sandbox, timeout, number) if run_cells else ([], [])
+        verdict, check_notes, result["copied"] = _check(number, book, sandbox, grade_timeout,
+                                                        seed)
         result["notes"] = errors + notes + check_notes
         if verdict is None:
             result["message"] = "no grade: your code could not be loaded for the checks"
@@ -187,7 +220,7 @@ def grade_book(name, book, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT
 
 
 def grade_notebook(path, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT, sandbox=None,
-                   problem=None):
+                   problem=None, seed=None):
     """Grade one notebook file (read as untrusted: see grading/submissions.py)."""
     from .grading.sandbox import Sandbox
 
@@ -199,18 +232,19 @@ def grade_notebook(path, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT, 
     if problem is not None:
         return _result(path.name, number, problem)
     try:
-        return grade_book(path.name, book, timeout, grade_timeout, sandbox)
+        return grade_book(path.name, book, timeout, grade_timeout, sandbox, seed=seed)
     except Exception as exc:  # noqa: BLE001 - one notebook's failure is its own
         return _result(path.name, number, f"could not grade the notebook: {type(exc).__name__}")
 
 
-def _grade_jobs(jobs_list, jobs, timeout, grade_timeout, sandbox):
+def _grade_jobs(jobs_list, jobs, timeout, grade_timeout, sandbox, seed):
     """Every notebook's result, in order; a worker that dies costs only its notebooks."""
     if jobs <= 1:
-        return [grade_notebook(nb, timeout, grade_timeout, sandbox, problem)
+        return [grade_notebook(nb, timeout, grade_timeout, sandbox, problem, seed)
                 for _, nb, problem in jobs_list]
     with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
-        futures = [pool.submit(grade_notebook, nb, timeout, grade_timeout, sandbox, problem)
+        futures = [pool.submit(grade_notebook, nb, timeout, grade_timeout, sandbox, problem,
+                               seed)
                    for _, nb, problem in jobs_list]
         outcomes = []
         for (_, nb, _), future in zip(jobs_list, futures):
@@ -224,10 +258,12 @@ def _grade_jobs(jobs_list, jobs, timeout, grade_timeout, sandbox):
 
 def grade_all(submissions, out, feedback=None, timeout=NOTEBOOK_TIMEOUT, jobs=1,
               grade_timeout=GRADE_TIMEOUT, log=print, limits=None, bwrap=None, collect=None,
-              unsandboxed=False, warn=None):
+              unsandboxed=False, warn=None, seed=None):
     """Grade every student folder; write the CSV and the feedback files; return the rows
-    (`collect`: a list that receives every notebook's result dict). Raises SandboxUnavailable
-    (no sandbox, and not `unsandboxed`) or SelfCheckFailed before grading anyone."""
+    (`collect`: a list that receives every notebook's result dict). The checks run on hidden
+    cases drawn from `seed` (None: a fresh secret one, logged so a run can be repeated).
+    Raises SandboxUnavailable (no sandbox, and not `unsandboxed`) or SelfCheckFailed before
+    grading anyone."""
     from .grading import selfcheck
     from .grading.sandbox import Limits, Sandbox
 
@@ -252,7 +288,9 @@ def grade_all(submissions, out, feedback=None, timeout=NOTEBOOK_TIMEOUT, jobs=1,
         log("sandbox: NOT enforced:")
         for line in not_enforced:
             log(f"  - {line}")
-        selfcheck.run(grade_book, sandbox, timeout, grade_timeout)
+        seed = secrets.randbits(63) if seed is None else int(seed)
+        log(f"hidden cases: seed {seed} (--seed {seed} grades on the same cases again)")
+        selfcheck.run(functools.partial(grade_book, seed=seed), sandbox, timeout, grade_timeout)
         log("self-check: a known-good answer got 10/10 and a wrapper of ikteach's own got 0")
         for name in ignored:
             log(f"ignored (not a student folder): {text(name)}")
@@ -268,7 +306,9 @@ def grade_all(submissions, out, feedback=None, timeout=NOTEBOOK_TIMEOUT, jobs=1,
                 notes[name].append(f"the folder could not be read: {exc.strerror or exc}")
                 continue
             jobs_list += [(name, path, why) for _, path, why in books]
-        outcomes = _grade_jobs(jobs_list, jobs, timeout, grade_timeout, sandbox)
+        # by exercise: each exercise's fork server (its own copy of ikteach) starts once
+        jobs_list.sort(key=lambda job: exercise_number(job[1], None) or 0)
+        outcomes = _grade_jobs(jobs_list, jobs, timeout, grade_timeout, sandbox, seed)
     finally:
         sandbox.close()
     if collect is not None:
@@ -298,6 +338,8 @@ def main(argv=None):
     parser.add_argument("--grade-timeout", type=float, default=GRADE_TIMEOUT,
                         help="seconds allowed for one notebook's checks (default %(default)s)")
     parser.add_argument("--jobs", type=int, default=1, help="notebooks graded at once")
+    parser.add_argument("--seed", type=int, default=None,
+                        help="the hidden cases' seed (default: a fresh secret one, logged)")
     parser.add_argument("--memory-mb", type=int, default=Limits.memory_mb,
                         help="address space of one student process, and the memory of one "
                              "sandbox where a memory cgroup can be made (default %(default)s)")
@@ -325,7 +367,8 @@ def main(argv=None):
     try:
         rows = grade_all(args.submissions, args.out, args.feedback, args.timeout, args.jobs,
                          args.grade_timeout, limits=limits,
-                         bwrap=False if args.no_bwrap else None, unsandboxed=args.no_sandbox)
+                         bwrap=False if args.no_bwrap else None, unsandboxed=args.no_sandbox,
+                         seed=args.seed)
     except ValueError as exc:
         parser.error(str(exc))
     except SandboxUnavailable as exc:

@@ -7,8 +7,8 @@ import numpy as np
 
 from ...core.chain import planar_chain
 from ...core.jacobian import jacobian as _ref_jacobian
-from .verdicts import (SEED, _Case, _Fail, _Part, _as_array, _call, _close, _evaluate, _fmt,
-                       _guarded, _mismatch, _report, _shape_message)
+from .verdicts import (_Case, _Fail, _Part, _as_array, _call, _close, _evaluate, _fmt,
+                       _guarded, _mismatch, _rng, _shape_message)
 
 NUMBER = 1
 CHECK_NAME = "jacobian"
@@ -25,14 +25,27 @@ REFERENCES = ("ikteach.core.jacobian:jacobian",
 )
 
 
-def _jacobian_cases():
-    rng = np.random.default_rng(SEED)
-    cases = []
-    hand = [([1.0], [0.0], "regular"), ([1.0, 1.0], [0.0, 0.0], "singular"),
-            ([1.0, 1.0], [0.0, np.pi], "singular"), ([1.0, 2.0], [0.3, 0.5], "regular"),
-            ([1.0, 1.0, 1.0], [0.0, 0.0, 0.0], "singular")]
-    for lengths, theta, tag in hand:
-        cases.append((lengths, theta, tag))
+HAND = [([1.0], [0.0], "regular"), ([1.0, 1.0], [0.0, 0.0], "singular"),
+        ([1.0, 1.0], [0.0, np.pi], "singular"), ([1.0, 2.0], [0.3, 0.5], "regular"),
+        ([1.0, 1.0, 1.0], [0.0, 0.0, 0.0], "singular")]
+
+
+def _hidden_hand(rng):
+    """HAND's kinds with other numbers: one link, straight and folded arms, two links."""
+    def lengths(n):
+        return rng.uniform(0.5, 1.5, n).round(3).tolist()
+
+    def angle():
+        return round(float(rng.uniform(-np.pi, np.pi)), 3)
+
+    return [(lengths(1), [angle()], "regular"), (lengths(2), [angle(), 0.0], "singular"),
+            (lengths(2), [angle(), np.pi], "singular"), (lengths(2), [angle(), angle()], "regular"),
+            (lengths(3), [angle(), 0.0, 0.0], "singular")]
+
+
+def _jacobian_cases(seed=None):
+    rng = _rng(seed, 0)
+    cases = list(HAND if seed is None else _hidden_hand(rng))
     for _ in range(12):
         n = int(rng.integers(1, 6))
         cases.append((rng.uniform(0.5, 1.5, n).round(3).tolist(),
@@ -70,8 +83,8 @@ def _columns_up_to_sign(got, want):
         _close(g, w) or _close(g, -w) for g, w in zip(got.T, want.T))
 
 
-def _jacobian_parts(fn, name):
-    cases = _jacobian_cases()
+def _jacobian_parts(fn, name, seed=None):
+    cases = _jacobian_cases(seed)
     cache = {}
 
     def result(case):
@@ -117,12 +130,7 @@ def _jacobian_parts(fn, name):
             _Part("sign", 2, sign), _Part("singular", 2, singular)]
 
 
-def verdict(planar_jacobian):
-    """Verdict for exercise 1 without printing."""
-    return _evaluate(NUMBER, TITLE, list(FUNCTIONS),
-                     _guarded(planar_jacobian, FUNCTIONS[0], _jacobian_parts))
-
-
-def check(planar_jacobian):
-    """Exercise 1: check planar_jacobian(lengths, theta) -> J (2, n), column i = z x (p_e - p_i)."""
-    _report(verdict(planar_jacobian))
+def verdict(planar_jacobian, seed=None):
+    """Verdict for exercise 1 without printing (`seed`: the grader's hidden cases)."""
+    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _guarded(
+        planar_jacobian, FUNCTIONS[0], lambda fn, name: _jacobian_parts(fn, name, seed)))

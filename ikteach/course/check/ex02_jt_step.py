@@ -6,8 +6,8 @@ J J^T e = 0 2.
 import numpy as np
 
 from ...core.jt import jt_step as _ref_jt
-from .verdicts import (SEED, _Case, _Fail, _Part, _as_array, _call, _close, _evaluate, _guarded,
-                       _matrix_text, _mismatch, _report, _shape_message)
+from .verdicts import (_Case, _Fail, _Part, _as_array, _call, _close, _evaluate, _guarded,
+                       _matrix_text, _mismatch, _rng, _shape_message)
 
 NUMBER = 2
 CHECK_NAME = "jt_step"
@@ -16,8 +16,7 @@ FUNCTIONS = ('jt_step',)
 # ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
 REFERENCES = ("ikteach.core.jt:jt_step", "ikteach.core.jt:optimal_alpha")
 
-def _step_cases(shapes_seed, count=12, extra=()):
-    rng = np.random.default_rng(shapes_seed)
+def _step_cases(rng, count=12, extra=()):
     out = list(extra)
     for k in range(count):
         m = int(rng.integers(2, 4))
@@ -28,20 +27,35 @@ def _step_cases(shapes_seed, count=12, extra=()):
     return sorted(out, key=lambda c: c.size)
 
 
-def _jt_cases():
+HAND = [(np.eye(2), np.array([1.0, 0.0]), "regular"),
+        (np.array([[1.0, 0.0, 0.0], [0.0, 2.0, 0.0]]), np.array([1.0, 1.0]), "regular"),
+        (np.array([[1.0, 2.0], [0.5, -1.0]]), np.zeros(2), "zero"),
+        (np.array([[1.0, 1.0], [0.0, 0.0]]), np.array([0.0, 1.0]), "zero"),
+        (np.zeros((2, 3)), np.array([0.5, -0.5]), "zero")]
+
+
+def _hidden_hand(rng):
+    """HAND's kinds with other numbers: a scaled identity, a diagonal J, e = 0, e orthogonal
+    to every column of J (a zero row), J = 0."""
+    a, b, c = rng.uniform(0.5, 2.0, 3).round(3)
+    n = int(rng.integers(2, 5))
+    return [(a * np.eye(2), rng.normal(size=2).round(3), "regular"),
+            (np.diag([a, b, c])[:2], rng.normal(size=2).round(3), "regular"),
+            (rng.normal(size=(2, n)).round(3), np.zeros(2), "zero"),
+            (np.vstack([rng.normal(size=n).round(3), np.zeros(n)]), np.array([0.0, c]), "zero"),
+            (np.zeros((2, n + 1)), rng.normal(size=2).round(3), "zero")]  # not square
+
+
+def _jt_cases(seed=None):
+    rng = _rng(seed, 2)
     hand = []
-    for k, (J, e, tag) in enumerate([
-            (np.eye(2), np.array([1.0, 0.0]), "regular"),
-            (np.array([[1.0, 0.0, 0.0], [0.0, 2.0, 0.0]]), np.array([1.0, 1.0]), "regular"),
-            (np.array([[1.0, 2.0], [0.5, -1.0]]), np.zeros(2), "zero"),
-            (np.array([[1.0, 1.0], [0.0, 0.0]]), np.array([0.0, 1.0]), "zero"),
-            (np.zeros((2, 3)), np.array([0.5, -0.5]), "zero")]):
+    for k, (J, e, tag) in enumerate(HAND if seed is None else _hidden_hand(rng)):
         hand.append(_Case((J, e), _matrix_text(J, e), size=J.size * 100 + k, tag=tag))
-    return _step_cases(SEED + 2, extra=hand)
+    return _step_cases(rng, extra=hand)
 
 
-def _jt_parts(fn, name):
-    cases = _jt_cases()
+def _jt_parts(fn, name, seed=None):
+    cases = _jt_cases(seed)
     cache = {}
 
     def result(case):
@@ -126,11 +140,7 @@ def _jt_parts(fn, name):
             _Part("zero", 2, zero)]
 
 
-def verdict(jt_step):
-    """Verdict for exercise 2 without printing."""
-    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _guarded(jt_step, FUNCTIONS[0], _jt_parts))
-
-
-def check(jt_step):
-    """Exercise 2: check jt_step(J, e) -> alpha J^T e with Buss's optimal alpha."""
-    _report(verdict(jt_step))
+def verdict(jt_step, seed=None):
+    """Verdict for exercise 2 without printing (`seed`: the grader's hidden cases)."""
+    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _guarded(
+        jt_step, FUNCTIONS[0], lambda fn, name: _jt_parts(fn, name, seed)))

@@ -1,23 +1,68 @@
 """Exercise 3: pinv_step(J, e, rcond) -> J^+ e by the SVD with a relative cut-off.
 
-Parts: regular J 5, the cut-off at singular J 3, J = 0 (sigma_max = 0: nothing is kept) 2.
+Parts: regular J, up to the sign 2; the sign 3 (so a sign slip costs what it costs in exercise
+2); small sigma dropped (the cut-off at singular and ill-conditioned J, up to the sign) 3; the
+guard for sigma_max = 0 (J = 0: nothing is kept) 2.
 """
 import numpy as np
 
 from ...core.pinv import pinv_step as _ref_pinv
-from .verdicts import (SEED, _Case, _Part, _as_array, _call, _close, _evaluate, _fmt, _guarded,
-                       _matrix_text, _mismatch, _report, _shape_message, _random_matrix,
+from .verdicts import (_Case, _Fail, _Part, _as_array, _call, _close, _evaluate, _fmt, _guarded,
+                       _matrix_text, _mismatch, _rng, _shape_message, _random_matrix,
                        _with_singular_values)
 
 NUMBER = 3
 CHECK_NAME = "pinv_step"
 TITLE = "the pseudoinverse step"
 FUNCTIONS = ('pinv_step',)
-# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
+# ikteach's own answer to this exercise: absent from the grader's sandbox (grading/reference.py)
 REFERENCES = ("ikteach.core.pinv:pinv_step", "ikteach.core.pinv:pinv_two_rows")
+FIXED_CUTOFFS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5)  # relative cut-offs of a step ignoring rcond
+SWAP_HINT = ("\n  hint: J (m x n) = U Sigma V^T with U m x k and V n x k: U^T takes e (m entries) "
+             "and V gives delta_theta (n entries), delta_theta = V Sigma^+ U^T e. U and V "
+             "swapped? (np.linalg.svd returns U, sigma and V^T.)")
 
-def _pinv_cases():
-    rng = np.random.default_rng(SEED + 3)
+
+def _singular_hand(rng):
+    """The instant check's singular and ill-conditioned J: (J, e, rcond)."""
+    return [
+        (np.array([[0.0, 0.0], [3.0, 2.0]]), np.array([1.0, 0.5]), 1e-6),  # straight 2-link arm
+        (np.array([[1.0, 1.0], [1.0, 1.0]]), np.array([1.0, -1.0]), 1e-6),
+        (_with_singular_values(rng, [1.0, 1e-9], 2, 3).round(12), np.array([0.3, 0.4]), 1e-6),
+        (_with_singular_values(rng, [100.0, 1e-5], 2, 2), np.array([1.0, 1.0]), 1e-6),
+        (_with_singular_values(rng, [1e-3, 1e-8], 2, 3), np.array([0.2, -0.1]), 1e-4),
+        # sigma_min / sigma_max between 1e-5 and 0.1: rcond decides, on either side
+        (_with_singular_values(rng, [1.0, 1e-3], 2, 3), np.array([0.5, -0.2]), 1e-6),
+        (_with_singular_values(rng, [2.0, 0.06], 2, 2), np.array([0.3, 0.7]), 0.05),
+        (_with_singular_values(rng, [1.0, 0.05, 1e-4], 3, 3), np.array([0.2, 0.1, -0.3]), 1e-2),
+    ]
+
+
+def _singular_hidden(rng):
+    """The same kinds with numbers drawn at grading time."""
+    a, b = rng.uniform(0.5, 3.0, 2).round(3)
+    u, v = rng.normal(size=2).round(3), rng.normal(size=2).round(3)
+    out = [(np.array([[0.0, 0.0], [a, b]]), rng.normal(size=2).round(3), 1e-6),
+           (np.outer(u, v), rng.normal(size=2).round(3), 1e-6)]
+    for sigma, m, n, rcond in ([[1.0, 1e-9], 2, 3, 1e-6], [[100.0, 1e-5], 2, 2, 1e-6],
+                               [[1e-3, 1e-8], 2, 3, 1e-4]):
+        scale = float(rng.uniform(0.5, 2.0))
+        out.append((_with_singular_values(rng, np.array(sigma) * scale, m, n),
+                    rng.normal(size=m).round(3), rcond))
+    # sigma_min / sigma_max between 1e-5 and 0.1, rcond on either side: a fixed cut-off fails
+    # one of them (kept below 1e-2, dropped above it, a tiny one kept and a middle one dropped)
+    low, high = 10 ** rng.uniform(-4, -2.3, 2), rng.uniform(0.02, 0.1)
+    tiny = 10 ** float(rng.uniform(-5, -4))
+    for sigma, rcond, m, n in (([1.0, low[0]], low[0] / 100, 2, 3), ([1.0, high], 2 * high, 2, 2),
+                               ([1.0, high, tiny], np.sqrt(high * tiny), 3, 3)):
+        scale = float(rng.uniform(0.5, 5.0))
+        out.append((_with_singular_values(rng, np.array(sigma) * scale, m, n),
+                    rng.normal(size=m).round(3), float(f"{rcond:.2g}")))
+    return out
+
+
+def _pinv_cases(seed=None):
+    rng = _rng(seed, 3)
     cases = []
     for k in range(10):
         m = int(rng.integers(2, 4))
@@ -26,99 +71,123 @@ def _pinv_cases():
         e = rng.normal(size=m).round(3)
         cases.append(_Case((J, e, 1e-6), _matrix_text(J, e, ", rcond = 1e-06"),
                            size=m * n * 100 + 50 + k, tag="regular"))
-    singular = [
-        (np.array([[0.0, 0.0], [3.0, 2.0]]), np.array([1.0, 0.5]), 1e-6),  # straight 2-link arm
-        (np.array([[1.0, 1.0], [1.0, 1.0]]), np.array([1.0, -1.0]), 1e-6),
-        (_with_singular_values(rng, [1.0, 1e-9], 2, 3).round(12), np.array([0.3, 0.4]), 1e-6),
-        (_with_singular_values(rng, [100.0, 1e-5], 2, 2), np.array([1.0, 1.0]), 1e-6),
-        (_with_singular_values(rng, [1e-3, 1e-8], 2, 3), np.array([0.2, -0.1]), 1e-4),
-    ]
+    singular = _singular_hand(rng) if seed is None else _singular_hidden(rng)
     for k, (J, e, rcond) in enumerate(singular):
         s = np.linalg.svd(J, compute_uv=False)
         cases.append(_Case((J, e, rcond), _matrix_text(J, e, f", rcond = {rcond:g}")
                            + f" (singular values {_fmt(s)})", size=J.size * 100 + k,
                            tag="cutoff"))
-    J, e = np.zeros((2, 3)), np.array([1.0, -0.5])
+    n = 3 if seed is None else int(rng.integers(3, 5))  # not square, as the instant check's
+    J, e = np.zeros((2, n)), (np.array([1.0, -0.5]) if seed is None
+                              else rng.normal(size=2).round(3))
     cases.append(_Case((J, e, 1e-6), _matrix_text(J, e, ", rcond = 1e-06") + " (J = 0: sigma_max = 0)",
                        size=J.size * 100, tag="zero"))
     return sorted(cases, key=lambda c: c.size)
 
 
-def _pinv_variant(J, e, cut):
+def _pinv_variant(J, e, cut, swapped=False):
     U, s, Vt = np.linalg.svd(J, full_matrices=False)
     keep = cut(s)
     with np.errstate(divide="ignore", invalid="ignore"):
         inv = np.where(keep, 1.0 / np.where(keep, s, 1.0), 0.0)
+    if swapped:
+        return U @ (inv * (Vt @ e)) if U.shape[0] == Vt.shape[1] else None
     return Vt.T @ (inv * (U.T @ e))
 
 
-def _pinv_parts(fn, name):
-    cases = _pinv_cases()
+def _relative(rcond):
+    return lambda s: (s >= rcond * s.max()) & (s > 0)
 
-    def run(tag):
-        def check():
-            results = {}
-            for case in (c for c in cases if c.tag == tag):
-                J, e, rcond = case.args
-                results[id(case)] = _as_array(_call(fn, name, case, J.copy(), e.copy(), rcond),
-                                              name, case)
-            absolute = all(_close(results[id(c)], _pinv_variant(*c.args[:2], lambda s, r=c.args[2]:
-                                                                 s >= r))
-                           for c in cases if c.tag == tag)
-            for case in (c for c in cases if c.tag == tag):
-                J, e, rcond = case.args
-                got = results[id(case)]
-                want = np.asarray(_ref_pinv(J, e, rcond))
-                if got.shape != want.shape:
-                    hint = (" - one entry per joint: delta_theta = V Sigma^+ U^T e"
-                            if got.shape == e.shape else "")
-                    return _shape_message(name, got, want, case, hint)
-                if _close(got, want):
-                    continue
-                if not np.all(np.isfinite(got)):
-                    return ("NaN or inf at a singular J: 1/sigma for a tiny or zero sigma. "
-                            "Drop 1/sigma_i (use 0) for sigma_i < rcond * sigma_max."
-                            + _mismatch(got, want, case))
-                if _close(got, -want):
-                    return "wrong sign: delta_theta = +J^+ e." + _mismatch(got, want, case)
-                if absolute and tag == "cutoff":
-                    return ("the cut-off must be relative: drop sigma_i < rcond * sigma_max "
-                            "(the largest singular value), not sigma_i < rcond."
-                            + _mismatch(got, want, case))
-                if _close(got, _pinv_variant(J, e, lambda s: s > 0), rtol=1e-4):
-                    return ("no cut-off: 1/sigma_i must be dropped for sigma_i < rcond * "
-                            f"sigma_max; here your step is {np.linalg.norm(got):.3g} long."
-                            + _mismatch(got, want, case))
-                if _close(got, _pinv_variant(J, e, lambda s: s >= rcond)):
-                    return ("the cut-off must be relative: drop sigma_i < rcond * sigma_max "
-                            "(the largest singular value), not sigma_i < rcond."
-                            + _mismatch(got, want, case))
-                return ("wrong values: delta_theta = sum_i (u_i . e / sigma_i) v_i over the "
-                        "sigma_i kept by the cut-off." + _mismatch(got, want, case))
-        return check
 
-    def zero():
-        for case in (c for c in cases if c.tag == "zero"):
+def _fixed_cutoff(results):
+    """The fixed relative cut-off that gives the student's step on every case of `results`
+    ([(case, got)]) when the rcond passed in does not, or None."""
+    for c in FIXED_CUTOFFS:
+        if all(_close(np.abs(got), np.abs(_pinv_variant(*case.args[:2], _relative(c))))
+               for case, got in results):
+            return c
+    return None
+
+
+def _diagnose(got, want, case):
+    """What is wrong with a step that is not J^+ e (nor -J^+ e)."""
+    J, e, rcond = case.args
+    if not np.all(np.isfinite(got)):
+        return ("NaN or inf at a singular J: 1/sigma for a tiny or zero sigma. "
+                "Drop 1/sigma_i (use 0) for sigma_i < rcond * sigma_max." + _mismatch(got, want, case))
+    swapped = _pinv_variant(J, e, _relative(rcond), swapped=True)
+    if swapped is not None and (_close(got, swapped) or _close(got, -swapped)):
+        return ("U and V swapped: delta_theta = V Sigma^+ U^T e (np.linalg.svd returns U, "
+                "sigma and V^T)." + _mismatch(got, want, case))
+    if _close(got, _pinv_variant(J, e, lambda s: s > 0), rtol=1e-4):
+        return ("no cut-off: 1/sigma_i must be dropped for sigma_i < rcond * "
+                f"sigma_max; here your step is {np.linalg.norm(got):.3g} long (np.linalg.pinv(J) "
+                "keeps every sigma_i >= 1e-15 sigma_max)." + _mismatch(got, want, case))
+    if _close(got, _pinv_variant(J, e, lambda s: s >= rcond)):
+        return ("the cut-off must be relative: drop sigma_i < rcond * sigma_max "
+                "(the largest singular value), not sigma_i < rcond." + _mismatch(got, want, case))
+    return ("wrong values: delta_theta = sum_i (u_i . e / sigma_i) v_i over the "
+            "sigma_i kept by the cut-off." + _mismatch(got, want, case))
+
+
+def _pinv_parts(fn, name, seed=None):
+    cases = _pinv_cases(seed)
+    cache = {}
+
+    def result(case):
+        if id(case) not in cache:
             J, e, rcond = case.args
-            got = _as_array(_call(fn, name, case, J.copy(), e.copy(), rcond), name, case)
-            want = np.asarray(_ref_pinv(J, e, rcond))
+            try:
+                got = _call(fn, name, case, J.copy(), e.copy(), rcond)
+            except _Fail as exc:
+                shapes = ("mismatch in its core dimension", "not aligned", "shapes")
+                if type(exc) is _Fail and any(word in str(exc) for word in shapes):
+                    raise _Fail(str(exc) + SWAP_HINT) from None
+                raise
+            cache[id(case)] = _as_array(got, name, case)
+        return cache[id(case)]
+
+    def compared(tag, signed):
+        """None, or the message of the first case of `tag` that fails (`signed`: the sign
+        counts; otherwise -J^+ e passes too)."""
+        for case in (c for c in cases if c.tag == tag):
+            J, e, rcond = case.args
+            got, want = result(case), np.asarray(_ref_pinv(J, e, rcond))
             if got.shape != want.shape:
-                return _shape_message(name, got, want, case, " - one entry per joint")
-            if not _close(got, want):
+                hint = (" - one entry per joint: delta_theta = V Sigma^+ U^T e"
+                        if got.shape == e.shape else "")
+                return _shape_message(name, got, want, case, hint)
+            if _close(got, want) or (not signed and _close(got, -want)):
+                continue
+            if _close(got, -want):
+                return "wrong sign: delta_theta = +J^+ e." + _mismatch(got, want, case)
+            results = [(c, result(c)) for c in cases if c.tag == tag]
+            if tag == "cutoff" and all(  # every case: sigma_i < rcond dropped
+                    _close(np.abs(g), np.abs(_pinv_variant(*c.args[:2], lambda s, r=c.args[2]:
+                                                            s >= r))) for c, g in results):
+                return ("the cut-off must be relative: drop sigma_i < rcond * sigma_max "
+                        "(the largest singular value), not sigma_i < rcond."
+                        + _mismatch(got, want, case))
+            fixed = _fixed_cutoff(results)
+            if tag == "cutoff" and fixed is not None:
+                return (f"your cut-off ignores `rcond`: on every case it drops what a fixed "
+                        f"relative cut-off of {fixed:g} drops; here rcond = {rcond:g}. Drop "
+                        "sigma_i < rcond * sigma_max with the rcond passed in."
+                        + _mismatch(got, want, case))
+            if tag == "zero":
                 return ("no guard for sigma_max = 0: for J = 0 every sigma_i is 0, so "
                         "rcond * sigma_max = 0 and `sigma_i >= rcond * sigma_max` keeps them "
                         "all - 1/0. Keep only sigma_i > 0 as well (the step is then zero)."
                         + _mismatch(got, want, case))
+            return _diagnose(got, want, case)
 
-    return [_Part("regular", 5, run("regular")), _Part("cut-off", 3, run("cutoff")),
-            _Part("J = 0", 2, zero)]
-
-
-def verdict(pinv_step):
-    """Verdict for exercise 3 without printing."""
-    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _guarded(pinv_step, FUNCTIONS[0], _pinv_parts))
+    return [_Part("regular", 2, lambda: compared("regular", signed=False)),
+            _Part("sign", 3, lambda: compared("regular", signed=True)),
+            _Part("small sigma dropped", 3, lambda: compared("cutoff", signed=False)),
+            _Part("sigma_max = 0 guard", 2, lambda: compared("zero", signed=False))]
 
 
-def check(pinv_step):
-    """Exercise 3: check pinv_step(J, e, rcond) -> J^+ e by the SVD with a relative cut-off."""
-    _report(verdict(pinv_step))
+def verdict(pinv_step, seed=None):
+    """Verdict for exercise 3 without printing (`seed`: the grader's hidden cases)."""
+    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _guarded(
+        pinv_step, FUNCTIONS[0], lambda fn, name: _pinv_parts(fn, name, seed)))

@@ -5,8 +5,8 @@ Parts: each form 4, the two forms agree 2.
 import numpy as np
 
 from ...core.dls import dls_step as _ref_dls
-from .verdicts import (SEED, _Case, _Part, _as_array, _call, _check_callable, _close, _evaluate,
-                       _fmt, _matrix_text, _mismatch, _report, _shape_message)
+from .verdicts import (_Case, _Part, _as_array, _call, _check_callable, _close, _evaluate,
+                       _fmt, _matrix_text, _mismatch, _rng, _shape_message)
 
 NUMBER = 4
 CHECK_NAME = "dls_step"
@@ -18,12 +18,25 @@ REFERENCES = ("ikteach.core.dls:dls_step",
               "ikteach.core.priority:damped_pinv",
 )
 
-def _dls_cases():
-    rng = np.random.default_rng(SEED + 4)
+HAND = [(np.array([[0.0, 0.0], [3.0, 2.0]]), np.array([1.0, 0.5]), 0.5, "singular J"),
+        (np.zeros((2, 3)), np.array([1.0, -1.0]), 0.3, "zero J"),
+        (np.eye(2), np.array([1.0, 2.0]), 0.5, "")]
+
+
+def _hidden_hand(rng):
+    """HAND's kinds with other numbers: a straight arm's J, J = 0, a scaled identity."""
+    a, b, c = rng.uniform(0.5, 3.0, 3).round(3)
+    lams = rng.uniform(0.1, 0.9, 3).round(3)
+    return [(np.array([[0.0, 0.0], [a, b]]), rng.normal(size=2).round(3), lams[0], "singular J"),
+            (np.zeros((2, int(rng.integers(3, 5)))), rng.normal(size=2).round(3), lams[1],
+             "zero J"),
+            (c * np.eye(2), rng.normal(size=2).round(3), lams[2], "")]
+
+
+def _dls_cases(seed=None):
+    rng = _rng(seed, 4)
     cases = []
-    hand = [(np.array([[0.0, 0.0], [3.0, 2.0]]), np.array([1.0, 0.5]), 0.5, "singular J"),
-            (np.zeros((2, 3)), np.array([1.0, -1.0]), 0.3, "zero J"),
-            (np.eye(2), np.array([1.0, 2.0]), 0.5, "")]
+    hand = HAND if seed is None else _hidden_hand(rng)
     for k, (J, e, lam, note) in enumerate(hand):
         cases.append(_Case((J, e, lam), _matrix_text(J, e, f", damping = {lam:g}")
                            + (f" ({note})" if note else ""), size=J.size * 100 + k))
@@ -38,8 +51,8 @@ def _dls_cases():
     return sorted(cases, key=lambda c: c.size)
 
 
-def _dls_parts(fns, names):
-    cases = _dls_cases()
+def _dls_parts(fns, names, seed=None):
+    cases = _dls_cases(seed)
     cache = {}
 
     def result(which, case):
@@ -92,13 +105,8 @@ def _dls_parts(fns, names):
     return [_Part(names[0], 4, form(0)), _Part(names[1], 4, form(1)), _Part("agree", 2, agree)]
 
 
-def verdict(dls_step, dls_step_normal):
-    """Verdict for exercise 4 without printing."""
+def verdict(dls_step, dls_step_normal, seed=None):
+    """Verdict for exercise 4 without printing (`seed`: the grader's hidden cases)."""
     names = list(FUNCTIONS)
     return _evaluate(NUMBER, TITLE, names,
-                     _dls_parts([dls_step, dls_step_normal], names))
-
-
-def check(dls_step, dls_step_normal):
-    """Exercise 4: check both DLS forms against ik.dls_step, and against each other."""
-    _report(verdict(dls_step, dls_step_normal))
+                     _dls_parts([dls_step, dls_step_normal], names, seed))

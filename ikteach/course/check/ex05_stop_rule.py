@@ -10,8 +10,8 @@ from ...core.chain import planar_chain
 from ...core.dls import dls_step as _ref_dls
 from ...core.solve import StopSolve
 from ...core.solve import solve as _solve
-from .verdicts import (SEED, SOLVE_LIMIT, _Case, _Fail, _Part, _call, _check_callable, _evaluate,
-                       _fmt, _report)
+from .verdicts import (SOLVE_LIMIT, _Case, _Fail, _Part, _call, _check_callable, _evaluate,
+                       _fmt, _rng)
 
 NUMBER = 5
 CHECK_NAME = "stop_rule"
@@ -67,13 +67,32 @@ _RULE_MISTAKES = [  # (a wrong rule, what to say), tried in this order against e
 ]
 
 
-def _stop_cases():
-    rng = np.random.default_rng(SEED + 5)
-    hand = [([0.1, -0.1], [1.0, 1.0], 1e-3), ([2e-3, 0.0, 0.0], [1.0, 1.0, 1.0], 1e-3),
-            ([1e-3, 1e-3, 1e-3], [1.0, 1.0, 1.0], 1e-3), ([0.05, 0.05], [10.0, 20.0], 1e-3),
-            ([-1e-3, 5e-4], [2.0, 1.0], 1e-3), ([0.5], [1.0], 1e-3),
-            ([5e-4, 5e-4], [0.5, 0.5], 1e-3),  # exactly at the threshold
-            ([6e-4, 6e-4], [0.5, 0.5], 1e-3)]  # each joint below it, their sum above
+HAND = [([0.1, -0.1], [1.0, 1.0], 1e-3), ([2e-3, 0.0, 0.0], [1.0, 1.0, 1.0], 1e-3),
+        ([1e-3, 1e-3, 1e-3], [1.0, 1.0, 1.0], 1e-3), ([0.05, 0.05], [10.0, 20.0], 1e-3),
+        ([-1e-3, 5e-4], [2.0, 1.0], 1e-3), ([0.5], [1.0], 1e-3),
+        ([5e-4, 5e-4], [0.5, 0.5], 1e-3),  # exactly at the threshold
+        ([6e-4, 6e-4], [0.5, 0.5], 1e-3)]  # each joint below it, their sum above
+
+
+def _hidden_hand(rng):
+    """HAND's kinds with other numbers: opposite steps that cancel, one joint at twice the
+    threshold, every joint at a third of it, long links, mixed signs, one link, exactly at the
+    threshold (binary fractions: the sums are exact), each joint below it but the sum above."""
+    f = float(rng.choice([1e-3, 1e-2]))
+    a = float(rng.choice([1, 2, 3, 5, 6, 7])) / 8  # k/8: a * f * 2 is exactly f * (a + a)
+    L2, L3 = (rng.uniform(0.5, 2.0, n).round(3).tolist() for n in (2, 3))
+    t2, t3 = f * sum(L2), f * sum(L3)
+    x = float(rng.uniform(0.02, 0.2))
+    return [([x, -x], rng.uniform(0.5, 2.0, 2).round(3).tolist(), f),
+            ([2 * t3, 0.0, 0.0], L3, f), ([t3 / 3] * 3, L3, f),
+            ([0.05, 0.05], rng.uniform(5.0, 30.0, 2).round(1).tolist(), f),
+            ([-t2 / 2, t2 / 4], L2, f), ([x * 5], [float(rng.uniform(0.5, 2.0))], f),
+            ([f * a, f * a], [a, a], f), ([0.6 * f * a * 2, 0.6 * f * a * 2], [a, a], f)]
+
+
+def _stop_cases(seed=None):
+    rng = _rng(seed, 5)
+    hand = list(HAND if seed is None else _hidden_hand(rng))
     for _ in range(10):
         n = int(rng.integers(1, 6))
         lengths = rng.uniform(0.3, 3.0, n).round(3)
@@ -97,12 +116,25 @@ def _as_bool(value, name, case):
                 "expected True or False")
 
 
-def _stop_parts(stalled, stop_rule_step):
+def _stop_setup(seed=None):
+    """(arm lengths, target out of reach, theta0) of the solve part: the instant check's, or
+    drawn (three links, a target 1.2 to 1.5 reaches away, a bent start)."""
+    if seed is None:
+        return STOP_ARM, STOP_TARGET, STOP_THETA0
+    rng = _rng(seed, 50)
+    arm = rng.uniform(0.7, 1.3, 3).round(2).tolist()
+    angle, reach = rng.uniform(-np.pi, np.pi), sum(arm) * rng.uniform(1.2, 1.5)
+    target = [round(float(reach * np.cos(angle)), 2), round(float(reach * np.sin(angle)), 2)]
+    return arm, target, rng.uniform(0.1, 0.4, 3).round(2).tolist()
+
+
+def _stop_parts(stalled, stop_rule_step, seed=None):
     names = ("stalled", "stop_rule_step")
+    arm_lengths, target, theta0 = _stop_setup(seed)
 
     def rule():
         _check_callable(stalled, names[0])
-        cases = _stop_cases()
+        cases = _stop_cases(seed)
         answers = [_as_bool(_call(stalled, names[0], case, case.args[0].copy(),
                                   list(case.args[1]), case.args[2]), names[0], case)
                    for case in cases]
@@ -123,17 +155,17 @@ def _stop_parts(stalled, stop_rule_step):
 
     def reference_step(J, e):
         delta = np.asarray(_BASE_STEP(J, e))
-        if _stalled_reference(delta, STOP_ARM, STOP_FRACTION):
+        if _stalled_reference(delta, arm_lengths, STOP_FRACTION):
             raise StopSolve("out of reach")
         return delta
 
     def run_solve(step, name):
-        case = (f"ik.solve(ik.planar_chain({STOP_ARM}), target={STOP_TARGET}, "
-                f"theta0={STOP_THETA0}, method=your step, stall_tol=0)")
-        arm = planar_chain(STOP_ARM)
+        case = (f"ik.solve(ik.planar_chain({arm_lengths}), target={target}, "
+                f"theta0={theta0}, method=your step, stall_tol=0)")
+        arm = planar_chain(arm_lengths)
 
         def go():
-            return _solve(arm, np.array(STOP_TARGET), np.array(STOP_THETA0), method=step,
+            return _solve(arm, np.array(target), np.array(theta0), method=step,
                           stall_tol=0.0, max_iter=STOP_MAX_ITER)
         try:
             return _call(go, name, case, limit=SOLVE_LIMIT), case
@@ -142,9 +174,10 @@ def _stop_parts(stalled, stop_rule_step):
 
     def solve_part():
         _check_callable(stop_rule_step, names[1])
-        case = (f"stop_rule_step(step, lengths={STOP_ARM}, fraction={STOP_FRACTION:g}) with "
-                f"step = DLS (damping {STOP_DAMPING:g})")
-        step = _call(stop_rule_step, names[1], case, _BASE_STEP, list(STOP_ARM), STOP_FRACTION)
+        case = (f"stop_rule_step(step, lengths={arm_lengths}, fraction={STOP_FRACTION:g}) "
+                f"with step = DLS (damping {STOP_DAMPING:g})")
+        step = _call(stop_rule_step, names[1], case, _BASE_STEP, list(arm_lengths),
+                     STOP_FRACTION)
         if not callable(step):
             return (f"`{names[1]}` must return a step function step(J, e) -> delta_theta; "
                     f"it returned {type(step).__name__}.")
@@ -163,12 +196,7 @@ def _stop_parts(stalled, stop_rule_step):
     return [_Part("rule", 5, rule), _Part("solve", 5, solve_part)]
 
 
-def verdict(stalled, stop_rule_step):
-    """Verdict for exercise 5 without printing."""
+def verdict(stalled, stop_rule_step, seed=None):
+    """Verdict for exercise 5 without printing (`seed`: the grader's hidden cases)."""
     return _evaluate(NUMBER, TITLE, list(FUNCTIONS),
-                     _stop_parts(stalled, stop_rule_step))
-
-
-def check(stalled, stop_rule_step):
-    """Exercise 5: check stalled(delta_theta, lengths, fraction) and stop_rule_step(...)."""
-    _report(verdict(stalled, stop_rule_step))
+                     _stop_parts(stalled, stop_rule_step, seed))

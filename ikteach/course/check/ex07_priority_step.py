@@ -7,8 +7,8 @@ no damping (lambda = 0, J1 singular or not: the exact pseudoinverses, finite) 2.
 import numpy as np
 
 from ...core.priority import priority_step as _ref_step
-from .verdicts import (SEED, _Case, _Fail, _Part, _as_array, _call, _check_callable, _close, _evaluate,
-                       _fmt, _mismatch, _report, _shape_message)
+from .verdicts import (_Case, _Fail, _Part, _as_array, _call, _check_callable, _close, _evaluate,
+                       _fmt, _mismatch, _rng, _shape_message)
 
 NUMBER = 7
 CHECK_NAME = "priority_step"
@@ -39,6 +39,22 @@ def _damped(A, lam):
     return A.T @ np.linalg.solve(A @ A.T + lam**2 * np.eye(A.shape[0]), np.eye(A.shape[0]))
 
 
+_DAMPING_MISTAKES = (  # (pseudoinverse used for J1 and for J2 N1, what is wrong)
+    (lambda A, lam: _damped(A, np.sqrt(lam)),
+     "the damping term is lambda^2 I, not lambda I: each damped pseudoinverse is "
+     "A^T (A A^T + lambda^2 I)^-1 (from lambda^2 |delta_theta|^2, as in exercise 4)."),
+    (lambda A, lam: np.linalg.pinv(A),
+     "no damping: your step uses exact pseudoinverses for damping > 0. Use the damped "
+     "A^T (A A^T + lambda^2 I)^-1 for J1 and for J2 N1 (exercise 4)."),
+)
+
+
+def _first_steps(J1, e1, lam):
+    """J1+ e1 damped with lambda^2 and with lambda (a slip in the damping, not in the
+    projection: the primary part keeps its points)."""
+    return [_damped(J1, lam) @ e1, _damped(J1, np.sqrt(lam)) @ e1]
+
+
 def _priority_variants(J1, e1, J2, e2, lam):
     """Common wrong steps, each with what it gets wrong."""
     n = J1.shape[1]
@@ -46,6 +62,10 @@ def _priority_variants(J1, e1, J2, e2, lam):
     N1 = np.eye(n) - np.linalg.pinv(J1) @ J1
     N2 = np.eye(n) - np.linalg.pinv(J2) @ J2  # J2 N2 = 0: the same as ignoring the secondary
     rest = e2 - J2 @ first
+    for damp, why in _DAMPING_MISTAKES:
+        J1_pinv = damp(J1, lam)
+        mine = J1_pinv @ e1
+        yield mine + N1 @ (damp(J2 @ N1, lam) @ (e2 - J2 @ mine)), why
     yield (first + _damped(J2, lam) @ rest,
            "the secondary step is not projected: J2+ (e2 - J2 J1+ e1) also moves the primary. "
            "Solve it in the null space of J1: N1 (J2 N1)+ (...) with N1 = I - J1+ J1.")
@@ -67,44 +87,80 @@ def _priority_variants(J1, e1, J2, e2, lam):
            "missing damping on (J2 N1)+: use the damped form there too.")
 
 
-def _priority_cases():
-    rng = np.random.default_rng(SEED + 7)
-    cases = []
-    hand = [
+def _primary_kept(got, J1, e1, lam):
+    """J1 delta = J1 J1+ e1 (J1+ damped with lambda^2, or lambda: that slip is another part's):
+    the secondary task moves nothing the primary sees."""
+    return (got.shape == (J1.shape[1],) and bool(np.all(np.isfinite(got)))
+            and any(np.allclose(J1 @ got, J1 @ first, rtol=1e-6, atol=1e-8)
+                    for first in _first_steps(J1, e1, lam)))
+
+
+HAND = {
+    "regular": [
         (np.array([[1.0, 0.0]]), np.array([1.0]), np.array([[0.0, 1.0]]), np.array([2.0]), 0.1,
          "independent tasks"),
         (np.array([[1.0, 0.0, 0.0]]), np.array([0.5]), np.array([[1.0, 1.0, 0.0]]), np.array([2.0]),
          0.1, "partial conflict"),
         (np.array([[1.0, 1.0, 0.0]]), np.array([1.0]), np.array([[1.0, 1.0, 0.0]]), np.array([-1.0]),
-         0.2, "full conflict: J2 = J1"),
-    ]
-    for k, (J1, e1, J2, e2, lam, note) in enumerate(hand):
-        cases.append(_Case((J1, e1, J2, e2, lam), _priority_text(J1, e1, J2, e2, lam, note),
-                           size=J1.size * 100 + k, tag="regular"))
-    singular = [
+         0.2, "full conflict: J2 = J1")],
+    "singular": [
         (np.zeros((2, 3)), np.array([1.0, -1.0]), np.array([[1.0, 0.0, 1.0]]), np.array([1.0]), 0.3,
          "singular: J1 = 0"),
         (np.array([[1.0, 1.0, 0.0], [2.0, 2.0, 0.0]]), np.array([1.0, 0.5]),
-         np.array([[0.0, 1.0, 1.0]]), np.array([0.5]), 0.2, "singular: rank-1 J1"),
-    ]
-    for k, (J1, e1, J2, e2, lam, note) in enumerate(singular):
-        cases.append(_Case((J1, e1, J2, e2, lam), _priority_text(J1, e1, J2, e2, lam, note),
-                           size=J1.size * 100 + k, tag="singular"))
+         np.array([[0.0, 1.0, 1.0]]), np.array([0.5]), 0.2, "singular: rank-1 J1")],
     # damping 0: A^T (A A^T)^-1 exists for J1 of full row rank, not for a singular J1
     # (J2 N1 has full row rank in every one of these, so only J1 decides)
-    undamped = [
+    "no damping": [
         (np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]), np.array([0.5, -1.0]),
-         np.array([[0.0, 1.0, 1.0]]), np.array([1.0]), "no damping, J1 of full row rank"),
+         np.array([[0.0, 1.0, 1.0]]), np.array([1.0]), 0.0, "no damping, J1 of full row rank"),
         (np.array([[1.0, 2.0, 0.0, -1.0], [0.0, 1.0, 1.0, 0.5]]), np.array([0.3, 0.2]),
-         np.array([[1.0, 0.0, 1.0, 1.0]]), np.array([-0.4]), "no damping, J1 of full row rank"),
-        (np.zeros((2, 3)), np.array([1.0, -1.0]), np.array([[1.0, 0.0, 1.0]]), np.array([1.0]),
+         np.array([[1.0, 0.0, 1.0, 1.0]]), np.array([-0.4]), 0.0, "no damping, J1 of full row rank"),
+        (np.zeros((2, 3)), np.array([1.0, -1.0]), np.array([[1.0, 0.0, 1.0]]), np.array([1.0]), 0.0,
          "no damping, singular: J1 = 0"),
         (np.array([[1.0, 1.0, 0.0], [2.0, 2.0, 0.0]]), np.array([1.0, 0.5]),
-         np.array([[0.0, 1.0, 1.0]]), np.array([0.5]), "no damping, singular: rank-1 J1"),
-    ]
-    for k, (J1, e1, J2, e2, note) in enumerate(undamped):
-        cases.append(_Case((J1, e1, J2, e2, 0.0), _priority_text(J1, e1, J2, e2, 0.0, note),
-                           size=J1.size * 100 + 10 + k, tag="no damping"))
+         np.array([[0.0, 1.0, 1.0]]), np.array([0.5]), 0.0, "no damping, singular: rank-1 J1")],
+}
+
+
+def _hidden_hand(rng):
+    """HAND's kinds with other numbers (tasks along the axes, a partial and a full conflict,
+    J1 = 0, a rank-1 J1 whose null space J2 reaches, full-rank J1 without damping)."""
+    def vec(n):
+        return rng.normal(size=n).round(3)
+
+    a, b, c = rng.uniform(0.5, 2.0, 3).round(3)
+    lam = lambda: round(float(rng.uniform(0.05, 0.5)), 3)  # noqa: E731
+    row = vec(3)
+    rank1 = np.outer([1.0, b], [a, c, 0.0])  # columns 0, 1 only: J2 below uses column 2
+    J2_free = np.array([[0.0, a, 1.0]])
+    full = np.array([[a, 0.0, 0.0], [0.0, b, 0.0]])
+    full4 = rng.normal(size=(2, 4)).round(3)
+    return {
+        "regular": [
+            (np.array([[a, 0.0]]), vec(1), np.array([[0.0, b]]), vec(1), lam(), "independent tasks"),
+            (np.array([[a, 0.0, 0.0]]), vec(1), np.array([[b, c, 0.0]]), vec(1), lam(),
+             "partial conflict"),
+            (row[None], vec(1), row[None], vec(1), lam(), "full conflict: J2 = J1")],
+        "singular": [
+            (np.zeros((2, 3)), vec(2), np.array([[1.0, 0.0, a]]), vec(1), lam(), "singular: J1 = 0"),
+            (rank1, vec(2), J2_free, vec(1), lam(), "singular: rank-1 J1")],
+        "no damping": [
+            (full, vec(2), np.array([[0.0, c, 1.0]]), vec(1), 0.0, "no damping, J1 of full row rank"),
+            (full4, vec(2), vec(4)[None], vec(1), 0.0, "no damping, J1 of full row rank"),
+            (np.zeros((2, 3)), vec(2), np.array([[1.0, 0.0, b]]), vec(1), 0.0,
+             "no damping, singular: J1 = 0"),
+            (rank1, vec(2), J2_free, vec(1), 0.0, "no damping, singular: rank-1 J1")],
+    }
+
+
+def _priority_cases(seed=None):
+    rng = _rng(seed, 7)
+    cases = []
+    hand = HAND if seed is None else _hidden_hand(rng)
+    for tag, offset in (("regular", 0), ("singular", 0), ("no damping", 10)):
+        for k, (J1, e1, J2, e2, lam, note) in enumerate(hand[tag]):
+            cases.append(_Case((J1, e1, J2, e2, lam), _priority_text(J1, e1, J2, e2, lam, note),
+                               size=J1.size * 100 + offset + k, tag=tag))
     for k in range(10):
         n = int(rng.integers(3, 7))
         m1, m2 = int(rng.integers(1, 3)), int(rng.integers(1, 3))
@@ -121,8 +177,8 @@ def _priority_text(J1, e1, J2, e2, lam, note=""):
             f"damping = {lam:g}" + (f" ({note})" if note else ""))
 
 
-def _priority_parts(fn, name):
-    cases = _priority_cases()
+def _priority_parts(fn, name, seed=None):
+    cases = _priority_cases(seed)
     cache = {}
 
     def result(case):
@@ -146,7 +202,7 @@ def _priority_parts(fn, name):
         for variant, why in _priority_variants(*case.args):
             if _close(got, variant) and not (lam == 0 and "damping" in why):
                 return why + _mismatch(got, want, case)
-        if not np.allclose(J1 @ got, J1 @ (_damped(J1, lam) @ e1), rtol=1e-6, atol=1e-8):
+        if not _primary_kept(got, J1, e1, lam):
             return ("the primary task is disturbed: J1 delta_theta should equal J1 J1+ e1 "
                     "(the secondary may move only in J1's null space)." + _mismatch(got, want, case))
         return (f"wrong values: `{name}` should compute J1+ e1 + N1 (J2 N1)+ (e2 - J2 J1+ e1)."
@@ -180,20 +236,14 @@ def _priority_parts(fn, name):
         for case in (c for c in cases if c.tag != "no damping"):
             J1, e1, J2, e2, lam = case.args
             got = result(case)
-            kept = (got.shape == (J1.shape[1],) and np.all(np.isfinite(got))
-                    and np.allclose(J1 @ got, J1 @ (_damped(J1, lam) @ e1), rtol=1e-6, atol=1e-8))
-            if not kept:
+            if not _primary_kept(got, J1, e1, lam):
                 return diagnose(got, _ref_priority(*case.args), case)
 
     return [_Part("primary kept", 3, primary_kept), _Part("secondary", 3, against_reference("regular")),
             _Part("singular", 2, against_reference("singular")), _Part("no damping", 2, no_damping)]
 
 
-def verdict(priority_step):
-    """Verdict for exercise 7 without printing."""
-    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _priority_parts(priority_step, "priority_step"))
-
-
-def check(priority_step):
-    """Exercise 7: check priority_step(J1, e1, J2, e2, damping) against ik.priority_step."""
-    _report(verdict(priority_step))
+def verdict(priority_step, seed=None):
+    """Verdict for exercise 7 without printing (`seed`: the grader's hidden cases)."""
+    return _evaluate(NUMBER, TITLE, list(FUNCTIONS),
+                     _priority_parts(priority_step, "priority_step", seed))

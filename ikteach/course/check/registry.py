@@ -1,17 +1,28 @@
-"""The exercise list: number -> its check module, and grade(number, namespace) for the grader."""
-from . import (ex01_jacobian, ex02_jt_step, ex03_pinv_step, ex04_dls_step, ex05_stop_rule,
-               ex06_singularity_study, ex07_priority_step)
+"""The exercise list, kept once: the modules exNN_<topic>.py of this folder, in number order.
+Everything else derives from it: EXERCISES (number -> module), NUMBERS (the exercises the
+grader grades and reports), ik.check.<CHECK_NAME> and ik.check.<CHECK_NAME>_verdict (the
+instant checks, check/__init__.py), grade(number, namespace) for the grader.
+"""
+import importlib
+import pkgutil
+import re
+from pathlib import Path
+
+from ..grading.reference import reached
 from .verdicts import POINTS, _evaluate, _Part
 
-MODULES = (ex01_jacobian, ex02_jt_step, ex03_pinv_step, ex04_dls_step, ex05_stop_rule,
-           ex06_singularity_study, ex07_priority_step)
+MODULES = tuple(importlib.import_module(f"{__package__}.{name}") for name in sorted(
+    info.name for info in pkgutil.iter_modules([str(Path(__file__).parent)])
+    if re.fullmatch(r"ex\d\d_\w+", info.name)))
 EXERCISES = {module.NUMBER: module for module in MODULES}
+NUMBERS = tuple(sorted(EXERCISES))
 
 
-def grade(number, namespace):
+def grade(number, namespace, seed=None):
     """The verdict for exercise `number`, taking the student's functions from `namespace`
-    (a dict: a notebook's globals, or the grader's proxies). Missing functions fail with a
-    message; nothing is printed."""
+    (a dict: a notebook's globals, or the grader's proxies), on the hidden cases drawn from
+    `seed` (None: the instant check's cases). Missing functions fail with a message; nothing
+    is printed."""
     if number not in EXERCISES:
         raise ValueError(f"number: expected one of {sorted(EXERCISES)}, got {number!r}")
     module = EXERCISES[number]
@@ -21,7 +32,7 @@ def grade(number, namespace):
             f"{', '.join('`' + n + '`' for n in missing)} not found in the notebook: keep the "
             "function names of the template."))]
         return _evaluate(number, module.TITLE, list(module.FUNCTIONS), parts)
-    return module.verdict(*(namespace[n] for n in module.FUNCTIONS))
+    return module.verdict(*(namespace[n] for n in module.FUNCTIONS), seed=seed)
 
 
 def refuse(number, message):
@@ -30,3 +41,35 @@ def refuse(number, message):
     module = EXERCISES[number]
     return _evaluate(number, module.TITLE, list(module.FUNCTIONS),
                      [_Part("own code", POINTS, lambda: message)])
+
+
+def instant_verdict(module):
+    """ik.check.<name>_verdict: the module's verdict in the student's notebook, where a graded
+    function that calls ikteach's own answer gets the 0 the grader will give it (the grader's
+    sandbox has those functions only as stubs that raise)."""
+    def verdict(*functions, seed=None):
+        used = reached(functions, module.REFERENCES)
+        if used:
+            names = ", ".join(ref.replace(":", ".") for ref in used)
+            return refuse(module.NUMBER, (
+                f"your code calls ikteach's own answer to this exercise ({names}). The grader "
+                "runs your notebook where those functions raise ReferenceBlocked, so this gets "
+                f"0/{POINTS} there: compute the answer in your own code (other ikteach "
+                "functions are fine)."))
+        return module.verdict(*functions, seed=seed)
+
+    verdict.__name__ = f"{module.CHECK_NAME}_verdict"
+    verdict.__doc__ = f"{module.__doc__.splitlines()[0]}\n\nReturns the Verdict, prints nothing."
+    return verdict
+
+
+def instant_check(module):
+    """ik.check.<name>: print the instant verdict."""
+    verdict = instant_verdict(module)
+
+    def check(*functions):
+        print(verdict(*functions).message)
+
+    check.__name__ = module.CHECK_NAME
+    check.__doc__ = f"{module.__doc__.splitlines()[0]}\n\nPrints the verdict."
+    return check

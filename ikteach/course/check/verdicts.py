@@ -146,6 +146,12 @@ def _shape_message(name, got, want, case, hint=""):
             f"{hint}.\n  smallest failing case: {case}")
 
 
+def _rng(seed, offset):
+    """The cases' random generator: seed None gives the instant check's (SEED + offset: what a
+    student sees in the notebook), an int the grader's hidden cases (drawn at grading time)."""
+    return np.random.default_rng(SEED + offset if seed is None else [int(seed), offset])
+
+
 def _random_matrix(rng, m, n, cond_max=1e3):
     """A random m x n matrix with singular values in [1, 10] (well conditioned)."""
     U, _ = np.linalg.qr(rng.normal(size=(m, m)))
@@ -232,10 +238,6 @@ def _evaluate(number, name, function_names, parts):
     marks = "  ".join(f"{p.name} {'ok' if results.get(p.name) else 'x'}" for p in parts)
     return Verdict(number, name, "failed", score, total,
                    f"{title}: {score:g}/{total:g} - {first_failure}\n  parts: {marks}", results)
-
-
-def _report(verdict):
-    print(verdict.message)
 
 
 def _check_callable(fn, name):

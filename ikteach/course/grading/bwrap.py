@@ -68,10 +68,12 @@ def python_paths(package):
     return [p for i, p in enumerate(kept) if not _inside(p, kept[:i])]
 
 
-def command(bwrap, flags, package, hidden, work, pid1=False, tmpfs_bytes=None, seccomp=None):
+def command(bwrap, flags, package, hidden, work, pid1=False, tmpfs_bytes=None, seccomp=None,
+            copy=None):
     """bwrap ... -- (argv follows): the whitelist, read-only; `work` the only writable folder;
     `pid1`: argv is the PID namespace's init (the fork server) instead of bwrap's reaper;
-    `tmpfs_bytes`: the size of each writable tmpfs; `seccomp`: the fd of seccomp_program()."""
+    `tmpfs_bytes`: the size of each writable tmpfs; `seccomp`: the fd of seccomp_program();
+    `copy`: a copy of ikteach shown in place of `package` (reference.py)."""
     args = [bwrap]
     for d in SYSTEM:
         if os.path.islink(d):
@@ -85,6 +87,8 @@ def command(bwrap, flags, package, hidden, work, pid1=False, tmpfs_bytes=None, s
     bound = python_paths(package)
     for path in bound:
         args += ["--ro-bind", str(path), str(path)]
+    if copy is not None:
+        args += ["--ro-bind", str(copy), str(package)]
     for path in hidden:  # only what lies inside a bound folder is visible at all
         if _inside(path, bound) and _is_dir(path):
             args += ["--tmpfs", str(path), "--remount-ro", str(path)]

@@ -169,18 +169,18 @@ def worker(requests_fd, replies_fd):
     requests = os.fdopen(requests_fd, "r", encoding="utf-8", errors="replace")
     replies = os.fdopen(replies_fd, "w")
     from ikteach.core.solve import StopSolve
-    from ikteach.course.grading import own_code
+    from ikteach.course.grading import own_code, reference
 
     def send(message):
         replies.write(json.dumps(message) + "\n")
         replies.flush()
 
     setup = json.loads(requests.readline())
-    own_code.block_checker()  # before any student statement: nothing of it is reachable
-    own_code.block(setup.get("references", []), setup.get("exercise"))
     namespace, notes = _define(setup["cells"])
+    held = reference.fingerprints(reference.held_code(namespace))  # reported, not trusted
     send({"ready": sorted(k for k, v in namespace.items() if callable(v) and k[:2] != "__"),
-          "notes": notes, "foreign": own_code.foreign(namespace, setup.get("graded", []))})
+          "notes": notes, "foreign": own_code.foreign(namespace, setup.get("graded", [])),
+          "held": held})
     handles = []
     for line in requests:
         request = json.loads(line)
@@ -204,25 +204,26 @@ def worker(requests_fd, replies_fd):
 # --- the grader's side ------------------------------------------------------------------------------
 
 class Worker:
-    """One worker for one notebook's code: a fresh child of the sandbox's fork server
-    (servers.py), started by start(). exercise, references, graded: the exercise number,
-    ikteach's functions to block (its check module's REFERENCES) and the names the check
-    grades; `limit`: seconds for the whole worker (start-up and every call), applied from
-    outside the student's process: it is then killed, whatever it does with its signals."""
+    """One worker for one notebook's code: a fresh child of the sandbox's fork server for
+    `exercise` (servers.py: its copy of ikteach has no answer to it), started by start().
+    graded: the names the check grades; `limit`: seconds for the whole worker (start-up and
+    every call), applied from outside the student's process: it is then killed, whatever it
+    does with its signals. After start(): names, notes, foreign (graded names not written in
+    the notebook), held ({fingerprint: function name} of the code its namespace holds)."""
 
-    def __init__(self, cells, sandbox, exercise=None, references=(), graded=(),
+    def __init__(self, cells, sandbox, exercise=None, graded=(),
                  limit=STARTUP_LIMIT + CALL_LIMIT):
-        self.cells, self.sandbox = cells, sandbox
-        self.setup = {"cells": cells, "exercise": exercise, "references": list(references),
-                      "graded": list(graded)}
+        self.cells, self.sandbox, self.exercise = cells, sandbox, exercise
+        self.setup = {"cells": cells, "graded": list(graded)}
         self.limit, self.deadline = limit, None
-        self.process, self.names, self.notes, self.foreign = None, [], [], {}
+        self.process, self.names, self.notes, self.foreign, self.held = None, [], [], {}, {}
 
     def start(self):
         from .servers import server_for
 
         self.deadline = time.monotonic() + self.limit
-        self.process = server_for(self.sandbox).job("worker", self.limit + 5, self.setup)
+        self.process = server_for(self.sandbox, self.exercise).job("worker", self.limit + 5,
+                                                                   self.setup)
         try:
             ready = self._read(STARTUP_LIMIT + STATEMENT_LIMIT * len(self.cells))
         except BaseException:
@@ -233,6 +234,9 @@ class Worker:
         foreign = ready.get("foreign", {})
         self.foreign = {str(k): str(v)[:400] for k, v in foreign.items()} \
             if isinstance(foreign, dict) else {}
+        held = ready.get("held", {})
+        self.held = {str(k)[:64]: str(v)[:80] for k, v in list(held.items())[:2000]} \
+            if isinstance(held, dict) else {}
         return self
 
     def _write(self, message):

@@ -1,5 +1,6 @@
 """The grader's outputs: one CSV row per student (ex1..ex7, total, the sandbox it ran in, notes:
-why a notebook was not graded) and one feedback file per student. Every text is printable UTF-8
+why a notebook was not graded, copied: graded code that is ikteach's own answer, for the
+instructor to judge) and one feedback file per student. Every text is printable UTF-8
 (grading/submissions.text), whatever the file names and notebooks held; no CSV cell starts a
 spreadsheet formula; each student's name is NFC-normalised, or written with escapes where two
 names differ only in normalisation; a feedback file name is short whatever the name's length."""
@@ -7,6 +8,8 @@ import csv
 import hashlib
 import unicodedata
 
+from ..check.registry import NUMBERS as EXERCISE_NUMBERS
+from ..check.verdicts import POINTS
 from .submissions import text
 
 FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
@@ -37,8 +40,6 @@ def file_name(label):
     digest = hashlib.sha256(raw).hexdigest()[:12]
     return raw[:MAX_FILE_NAME].decode("utf-8", "ignore") + "-" + digest + ".txt"
 
-EXERCISE_NUMBERS = range(1, 8)
-POINTS = 10
 
 
 def _feedback_text(student, results):
@@ -54,6 +55,9 @@ def _feedback_text(student, results):
             lines.append(f"  {line}")
         for note in r["notes"]:
             lines.append(f"  note: {note}")
+        for line in r.get("copied", []):
+            lines.append(f"  for the instructor: {line} (compiled code compared, names and "
+                         "docstrings ignored); the marks stand until the instructor decides")
         if r.get("answer", "").strip():
             lines.append("  your written answer (not marked by the checker; read by the "
                          "instructor):")
@@ -87,6 +91,8 @@ def write_results(per_student, notes, out, feedback, backend):
         row["total"] = sum(row[f"ex{n}"] for n in EXERCISE_NUMBERS)
         row["sandbox"] = backend
         row["notes"] = text(" | ".join(notes[student]))[:2000]
+        row["copied"] = text(" | ".join(f"ex{n}: {line}" for n in EXERCISE_NUMBERS
+                                        if n in best for line in best[n].get("copied", [])))
         rows.append(row)
         page = _feedback_text(row["student"], results)
         if notes[student] and not results:
@@ -96,7 +102,7 @@ def write_results(per_student, notes, out, feedback, backend):
     with open(out, "w", newline="", encoding="utf-8") as handle:
         writer = csv.DictWriter(handle, fieldnames=["student"] + [f"ex{n}" for n in
                                                                   EXERCISE_NUMBERS]
-                                + ["total", "sandbox", "notes"])
+                                + ["total", "sandbox", "notes", "copied"])
         writer.writeheader()
         for row in rows:
             writer.writerow({k: (f"{v:g}" if isinstance(v, float) else cell(v))

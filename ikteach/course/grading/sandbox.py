@@ -254,9 +254,23 @@ class Sandbox:
                     pass
         return made
 
-    def command(self, argv, work, cgroups, pid1=False, seccomp=None):
+    def package_for(self, exercise):
+        """The copy of ikteach that the jobs of `exercise` see (None: a probe's, nothing
+        stubbed): reference.py, the reference rule."""
+        from ..check import EXERCISES
+        from .reference import sandbox_copy
+
+        folder = self.work_root / f"package-{exercise or 0}"
+        folder.mkdir(exist_ok=True)
+        if exercise is None:
+            return sandbox_copy(self.package, folder / "ikteach")
+        return sandbox_copy(self.package, folder / "ikteach", EXERCISES[exercise].REFERENCES,
+                            exercise, base=self.package_for(None))
+
+    def command(self, argv, work, cgroups, pid1=False, seccomp=None, package=None):
         """The full command line: launcher (limits), then bwrap (if any), then argv (`pid1`:
-        as the init of its PID namespace; `seccomp`: the fd of bwrap's filter)."""
+        as the init of its PID namespace; `seccomp`: the fd of bwrap's filter; `package`: the
+        copy of ikteach it sees)."""
         lim = self.limits
         nproc = lim.processes if (not self.root and "pids" not in self.controlled) else 0
         launch = [sys.executable, "-S", str(LAUNCH), str(lim.cpu_seconds),
@@ -266,26 +280,32 @@ class Sandbox:
             return launch + list(argv)
         tmpfs = lim.tmpfs_mb << 20 if self.sized_tmpfs else None
         return launch + _bwrap.command(self.bwrap, self.flags, self.package, self.hidden,
-                                       Path(work), pid1, tmpfs, seccomp) + list(argv)
+                                       Path(work), pid1, tmpfs, seccomp, package) + list(argv)
 
-    def environment(self, work):
+    def environment(self, work, package=None):
+        """The bare environment of a run; `package`: the copy of ikteach it imports (without
+        bubblewrap, which shows the copy in ikteach's own place)."""
         home = Path(work) / "home"
         (home / "tmp").mkdir(parents=True, exist_ok=True)
         env = {"PATH": f"{Path(sys.executable).parent}:/usr/local/bin:/usr/bin:/bin",
                "HOME": str(home), "TMPDIR": str(home / "tmp"), "LANG": "C.UTF-8",
                "MPLBACKEND": "Agg", "JAX_PLATFORMS": "cpu", "PYTHONDONTWRITEBYTECODE": "1",
-               "PYTHONNOUSERSITE": "1", "PYTHONPATH": str(self.package.parent)}
+               "PYTHONNOUSERSITE": "1", "PYTHONPATH": str((package or self.package).parent)}
         env.update({k: os.environ[k] for k in PASSED_THROUGH if k in os.environ})
         return env
 
-    def start(self, argv, work, pid1=False, pass_fds=(), **popen):
-        """A running Process for argv in `work` (a folder the caller created)."""
+    def start(self, argv, work, pid1=False, pass_fds=(), exercise=None, **popen):
+        """A running Process for argv in `work` (a folder the caller created), seeing the copy
+        of ikteach made for `exercise`."""
         cgroups = self._cgroups()
+        package = self.package_for(exercise)
         seccomp = _bwrap.seccomp_fd() if self.bwrap else None
         fds = tuple(pass_fds) + ((seccomp,) if seccomp is not None else ())
-        try:
-            proc = subprocess.Popen(self.command(argv, work, cgroups, pid1, seccomp), cwd=work,
-                                    env=self.environment(work), pass_fds=fds, **popen)
+        try:  # bubblewrap shows the copy where ikteach lies; without it, PYTHONPATH names it
+            proc = subprocess.Popen(self.command(argv, work, cgroups, pid1, seccomp, package),
+                                    cwd=work, env=self.environment(work, None if self.bwrap
+                                                                   else package),
+                                    pass_fds=fds, **popen)
         finally:
             if seccomp is not None:
                 os.close(seccomp)

@@ -2,21 +2,40 @@
 notebook built here, so it needs no instructor folder) must get full marks through the same
 sandbox, runner and worker as every student; a known wrapper of ikteach's own jt_step must
 get none. Otherwise the grader cannot grade on this machine (its Python or packages not
-visible in the sandbox, a backend that fails, a blocked reference that still answers) and
-stops before writing a CSV of wrong zeros.
-"""
+visible in the sandbox, a backend that fails, a reference that still answers) and stops
+before writing a CSV of wrong zeros.
 
+The known-good answer is the source of ikteach's own module of exercise 2's references (jt.py:
+jt_step, optimal_alpha), undecorated, as a cell (good_answer): the package holds no other
+answer, and the sandbox's copy of ikteach holds those functions only as stubs
+(grading/reference.py) - so the self-check also shows that code typed into a cell is graded
+while the library's own functions answer nothing.
+"""
+import ast
+import importlib
+import inspect
+
+EXERCISE = 2
 SETUP = "import numpy as np\nimport ikteach as ik\n"
-GOOD = '''\
-def jt_step(J, e):
-    J, e = np.asarray(J), np.asarray(e)
-    g = J.T @ e
-    v = J @ g
-    vv = v @ v
-    if vv == 0:
-        return np.zeros(J.shape[1])
-    return (e @ v / vv) * g
-'''
+
+
+def good_answer():
+    """The module holding exercise 2's first reference, as a cell: its imports, constants and
+    functions, without decorators (no jit: plain code, as a student writes it)."""
+    from ..check import EXERCISES
+
+    module = importlib.import_module(EXERCISES[EXERCISE].REFERENCES[0].split(":")[0])
+    kept = []
+    for node in ast.parse(inspect.getsource(module)).body:
+        if isinstance(node, ast.FunctionDef):
+            node.decorator_list = []
+        if isinstance(node, (ast.Import, ast.Assign, ast.FunctionDef)) or (
+                isinstance(node, ast.ImportFrom) and node.level == 0):
+            kept.append(node)
+    return ast.unparse(ast.Module(kept, [])) + "\n"
+
+
+GOOD = good_answer()
 WRAPPER = "def jt_step(J, e):\n    return ik.jt_step(J, e)\n"
 
 
@@ -27,7 +46,7 @@ class SelfCheckFailed(RuntimeError):
 def book(source):
     code = [{"cell_type": "code", "metadata": {}, "outputs": [], "execution_count": None,
              "source": text} for text in (SETUP, source)]
-    return {"cells": code, "metadata": {"ikteach": {"exercise": 2}}, "nbformat": 4,
+    return {"cells": code, "metadata": {"ikteach": {"exercise": EXERCISE}}, "nbformat": 4,
             "nbformat_minor": 5}
 
 
@@ -38,7 +57,8 @@ def run(grade_book, sandbox, timeout, grade_timeout):
         result = grade_book("self-check.ipynb", book(source), timeout, grade_timeout, sandbox,
                             run_cells=cells)
         # the known-good answer also runs its cells: no errors, no notes (the runner works)
-        if result["score"] != expected or result["exercise"] != 2 or (cells and result["notes"]):
+        if (result["score"] != expected or result["exercise"] != EXERCISE
+                or (cells and result["notes"])):
             details = "; ".join([result["message"]] + result["notes"])[:1500]
             raise SelfCheckFailed(
                 f"the grader's self-check failed: {name} (exercise 2) got "

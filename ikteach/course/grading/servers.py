@@ -30,12 +30,15 @@ class ServerFailed(RuntimeError):
     """The fork server could not start (the message says why: e.g. an import error)."""
 
 
-def server_for(sandbox):
-    """This process's running server for `sandbox` (a new one if it has none or it broke)."""
-    key = str(sandbox.work_root)
+def server_for(sandbox, exercise=None):
+    """This process's running server for `sandbox` and `exercise` (whose copy of ikteach it
+    sees: reference.py), a new one if it has none or it broke."""
+    key = (str(sandbox.work_root), exercise)
+    for other in [k for k in _servers if k[0] == key[0] and k != key]:
+        _servers.pop(other).stop()  # one server per sandbox at a time: each holds JAX
     server = _servers.get(key)
     if server is None or not server.alive():
-        _servers[key] = server = Server(sandbox)
+        _servers[key] = server = Server(sandbox, exercise)
     return server
 
 
@@ -49,7 +52,7 @@ atexit.register(close_all)
 
 
 class Server:
-    def __init__(self, sandbox):
+    def __init__(self, sandbox, exercise=None):
         self.sandbox, self.jobs, self.broken = sandbox, 0, False
         self.dir = Path(tempfile.mkdtemp(prefix="server-", dir=sandbox.work_root))
         try:
@@ -60,7 +63,8 @@ class Server:
         try:
             self.process = sandbox.start(
                 [sys.executable, "-m", "ikteach.course.grading.forkserver", str(theirs.fileno()),
-                 "1" if sandbox.bwrap else "0"], self.dir, pid1=True, pass_fds=(theirs.fileno(),),
+                 "1" if sandbox.bwrap else "0"], self.dir, pid1=True, exercise=exercise,
+                pass_fds=(theirs.fileno(),),
                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         finally:
             theirs.close()

@@ -1,0 +1,127 @@
+"""The grader's hidden cases: drawn from a seed at grading time, the same kinds as the instant
+check (singular ones included), never its numbers; the instructor's solutions keep full marks
+on them and a table of the instant check's answers earns nothing."""
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import ikteach as ik
+from ikteach.course import check
+from ikteach.course.grading.cells import only_checks
+from ikteach.course.grading.extract import code_cells
+
+ROOT = Path(__file__).resolve().parents[1]
+CASES = {1: "_jacobian_cases", 2: "_jt_cases", 3: "_pinv_cases", 4: "_dls_cases",
+         5: "_stop_cases", 7: "_priority_cases"}
+SEEDS = (1, 20261125, 2**62 + 7)
+
+
+def cases(number, seed):
+    return getattr(check.EXERCISES[number], CASES[number])(seed)
+
+
+def kind(case):
+    """What kind of case it is: its tag and the note in brackets (not the values)."""
+    note = case.text.rsplit("(", 1)[-1] if case.text.endswith(")") else ""
+    return case.tag, "" if "singular values" in note else note
+
+
+def numbers(case):
+    return tuple(np.asarray(a, dtype=float).round(12).tobytes() for a in case.args
+                 if np.size(a) > 1 or float(np.asarray(a).ravel()[0]) not in (0.0, 1.0))
+
+
+@pytest.mark.parametrize("number", sorted(CASES))
+@pytest.mark.parametrize("seed", SEEDS)
+def test_hidden_cases_are_the_same_kinds_with_other_numbers(number, seed):
+    instant, hidden = cases(number, None), cases(number, seed)
+    assert len(hidden) == len(instant)
+    assert sorted(map(kind, hidden)) == sorted(map(kind, instant))
+    seen = {numbers(c) for c in instant}
+    assert not [c.text for c in hidden if numbers(c) in seen]  # no case of the instant check
+    assert [c.text for c in cases(number, seed)] == [c.text for c in hidden]  # reproducible
+
+
+def test_hidden_singular_cases_are_singular():
+    for seed in SEEDS:
+        for case in (c for c in cases(1, seed) if c.tag == "singular"):
+            lengths, theta = case.args
+            J = check.ex01_jacobian._jacobian_reference(lengths, theta)
+            assert np.linalg.matrix_rank(J, tol=1e-9) < min(J.shape)
+        for case in (c for c in cases(7, seed) if "singular" in c.text):
+            assert np.linalg.matrix_rank(case.args[0], tol=1e-9) < case.args[0].shape[0]
+        zero = [c for c in cases(3, seed) if c.tag == "zero"]
+        assert zero and all(not np.any(c.args[0]) for c in zero)
+
+
+def solution(number):
+    path = next((ROOT / "instructor" / "solutions").glob(f"{number:02d}_*.ipynb"))
+    namespace = {}
+    for cell, source in code_cells(json.loads(path.read_text())):
+        if not only_checks(source):
+            exec(compile(source, f"<cell {cell}>", "exec"), namespace)
+    return namespace
+
+
+@pytest.mark.parametrize("number", [1, 2, 3, 4, 5, 7])
+def test_the_solutions_keep_full_marks_on_hidden_cases(number):
+    namespace = solution(number)
+    for seed in (None,) + SEEDS:
+        verdict = check.grade(number, namespace, seed=seed)
+        assert verdict.score == 10, (seed, verdict.message)
+
+
+def test_a_table_of_the_instant_checks_answers_earns_nothing_but_the_shape_hidden():
+    """Exercise 1 answered from a lookup table of the instant check's cases (which a student
+    can read off ikteach's source): full marks there, nothing on the grader's cases."""
+    table = {(tuple(c.args[0]), tuple(c.args[1])): check.ex01_jacobian._jacobian_reference(*c.args)
+             for c in cases(1, None)}
+
+    def memorised(lengths, theta):
+        return table.get((tuple(lengths), tuple(np.asarray(theta).tolist())),
+                         np.zeros((2, len(lengths))))
+
+    assert check.jacobian_verdict(memorised).score == 10
+    for seed in SEEDS:  # only the shape's 2 points: its zeros have the right shape
+        verdict = check.jacobian_verdict(memorised, seed=seed)
+        assert verdict.score == 2 and verdict.parts["shape"], verdict.message
+
+
+def test_a_memorised_stop_count_earns_only_the_rule_hidden():
+    """Exercise 5's solve part answered by counting to the instant check's iteration count."""
+    stalled = solution(5)["stalled"]
+    base = check.stop_rule_verdict(stalled, lambda step, L, f: step).message
+    count = int(base.split("expected: stalled after ")[1].split()[0])
+
+    def stop_rule_step(step, lengths, fraction):
+        calls = []
+
+        def counted(J, e):
+            calls.append(1)
+            if len(calls) > count:
+                raise ik.StopSolve("memorised")
+            return np.asarray(step(J, e))
+        return counted
+
+    assert check.stop_rule_verdict(stalled, stop_rule_step).score == 10
+    assert all(check.stop_rule_verdict(stalled, stop_rule_step, seed=s).score == 5 for s in SEEDS)
+
+
+def notebook_functions(path):
+    namespace = {}
+    for cell, source in code_cells(json.loads(path.read_text())):
+        if not only_checks(source):
+            exec(compile(source, f"<cell {cell}>", "exec"), namespace)
+    return namespace
+
+
+@pytest.mark.parametrize("student, number, marks", [
+    ("sign_error", 1, 6), ("fixed_alpha", 2, 7), ("no_cutoff", 3, 7),
+    ("lambda_not_squared", 4, 2), ("exception", 2, 0)])
+def test_a_wrong_answer_costs_the_same_on_every_draw(student, number, marks):
+    """tests/submissions' wrong answers: the marks test_grade expects, whatever the seed."""
+    namespace = notebook_functions(next((ROOT / "tests" / "submissions" / student).glob("*.ipynb")))
+    for seed in (None,) + SEEDS + (7, 8, 9):
+        assert check.grade(number, namespace, seed=seed).score == marks, seed

@@ -1,0 +1,188 @@
+"""The reference rule, graded as a class (issue 35): every spelling of "use ikteach's own
+answer" that the grader can stop scores nothing, because the sandbox of the graded exercise
+holds that answer only as a stub (grading/reference.py); the answers a notebook carries in
+itself (a marshalled blob, source typed in) are reported in grades.csv's `copied` column and
+the feedback, for the instructor; a lookup table of the instant check's cases meets hidden
+cases. Beside them an honest student (the instructor's solutions) keeps 70/70, and the class
+gets its grades.csv. Without bubblewrap the same run is made with --no-sandbox (the copy of
+ikteach is then what PYTHONPATH points at)."""
+import base64
+import csv
+import inspect
+import json
+import marshal
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import nbformat
+import numpy as np
+import pytest
+
+from ikteach.core import pinv
+from ikteach.course import check
+from sandboxes import SANDBOXED
+
+ROOT = Path(__file__).resolve().parents[1]
+SOLUTIONS = ROOT / "instructor" / "solutions"
+
+RELOAD = '''\
+import importlib
+import ikteach.core.pinv as _pinv_module
+
+
+def pinv_step(J, e, rcond):
+    return np.asarray(importlib.reload(_pinv_module).pinv_step(J, e, rcond))
+'''
+SUBPROCESS = '''\
+import json, subprocess, sys
+_SERVER = ("import json, sys, numpy as np, ikteach as ik\\n"
+           "for line in sys.stdin:\\n"
+           "    J, e = json.loads(line)\\n"
+           "    print(json.dumps(np.asarray(ik.jt_step(np.array(J), np.array(e))).tolist()), flush=True)\\n")
+_child = []
+
+
+def jt_step(J, e):
+    """Answered by a fresh Python that imports ikteach, over a pipe."""
+    if not _child:
+        _child.append(subprocess.Popen([sys.executable, "-c", _SERVER], stdin=subprocess.PIPE,
+                                       stdout=subprocess.PIPE, text=True))
+    _child[0].stdin.write(json.dumps([np.asarray(J).tolist(), np.asarray(e).tolist()]) + "\\n")
+    _child[0].stdin.flush()
+    return np.array(json.loads(_child[0].stdout.readline()))
+'''
+EXEC_SOURCE = '''\
+import ikteach.core.priority as _library
+_scope = {"__name__": "ikteach.core.priority"}
+_run = exec(compile(open(_library.__file__).read(), "<cell 3>", "exec"), _scope)
+priority_step = _scope["priority_step"]
+'''
+SELFCHECK = '''\
+import importlib
+_selfcheck = importlib.import_module("ikteach.course.grading.selfcheck")
+_run = exec(_selfcheck.good_answer(), globals())
+'''
+MARSHAL_AT_RUN_TIME = '''\
+import marshal, types
+import ikteach.core.pinv as _library
+_f = types.FunctionType(marshal.loads(marshal.dumps(_library.pinv_step.__wrapped__.__code__)),
+                        vars(_library))
+
+
+def pinv_step(J, e, rcond):
+    return np.asarray(_f(J, e, rcond))
+'''
+MARSHAL_BLOB = '''\
+import base64, marshal, types
+import jax.numpy as jnp
+_f = types.FunctionType(marshal.loads(base64.b64decode("{blob}")), {{"jnp": jnp}})
+
+
+def pinv_step(J, e, rcond):
+    return np.asarray(_f(J, e, rcond))
+'''
+LOOKUP = '''\
+_TABLE = {table!r}
+
+
+def planar_jacobian(lengths, theta):
+    key = repr((list(lengths), [float(t) for t in theta]))
+    return np.array(_TABLE.get(key, np.zeros((2, len(lengths))).tolist()))
+'''
+
+
+def by_hand():
+    """ikteach's pinv_step typed into the notebook, names changed: plagiarism, reported."""
+    source = inspect.getsource(pinv.pinv_step.__wrapped__).replace("@jax.jit\n", "")
+    return ("import numpy as jnp\n\n\n" + source.replace("sigma", "s").replace("rcond=DEFAULT_RCOND", "rcond"))
+
+
+def lookup_table():
+    table = {}
+    for case in check.ex01_jacobian._jacobian_cases():
+        lengths, theta = case.args
+        key = repr((list(lengths), [float(t) for t in theta]))
+        table[key] = check.ex01_jacobian._jacobian_reference(lengths, theta).tolist()
+    return LOOKUP.format(table=table)
+
+
+def marshal_blob():
+    """Made at home with the student's own ikteach (the same Python as the grader's)."""
+    code = marshal.dumps(pinv.pinv_step.__wrapped__.__code__)
+    return MARSHAL_BLOB.format(blob=base64.b64encode(code).decode())
+
+
+# (student, exercise, its function's cell, marks, a line of the feedback, copied?)
+SPELLINGS = [
+    ("reload", 3, RELOAD, 0, "`pinv_step` raised ReferenceBlocked: ikteach's pinv_step is the "
+                             "reference answer of exercise 3", False),
+    ("fresh_python", 2, SUBPROCESS, 0, "`jt_step` raised JSONDecodeError", False),
+    ("exec_source", 7, EXEC_SOURCE, 0, "`priority_step` raised ReferenceBlocked: ikteach's "
+                                       "priority_step is the reference answer", False),
+    ("selfcheck_answer", 2, SELFCHECK, 0, "`jt_step` not found in the notebook", False),
+    ("marshal_at_run_time", 3, MARSHAL_AT_RUN_TIME, 0, "`pinv_step` raised ReferenceBlocked",
+     False),
+    ("marshal_blob", 3, None, 10, "has the same code as ikteach.core.pinv.pinv_step", True),
+    ("typed_in", 3, None, 10, "`pinv_step` has the same code as ikteach.core.pinv.pinv_step",
+     True),
+    ("lookup_table", 1, None, 2, "lever arms x", False),
+]
+FUNCTION = {1: "planar_jacobian", 2: "jt_step", 3: "pinv_step", 7: "priority_step"}
+
+
+def write_student(subs, student, number, source):
+    path = next(SOLUTIONS.glob(f"{number:02d}_*.ipynb"))
+    book = nbformat.read(path, as_version=4)
+    name = FUNCTION[number]
+    for cell in book.cells:
+        if cell.cell_type == "code" and f"def {name}(" in cell.source:
+            cell.source = source
+    (subs / student).mkdir()
+    nbformat.write(book, subs / student / path.name)
+
+
+@pytest.fixture(scope="module")
+def graded(tmp_path_factory):
+    base = tmp_path_factory.mktemp("reference-rule")
+    subs = base / "submissions"
+    shutil.copytree(SOLUTIONS, subs / "honest")
+    sources = {"marshal_blob": marshal_blob(), "typed_in": by_hand(), "lookup_table": lookup_table()}
+    for student, number, source, *_ in SPELLINGS:
+        write_student(subs, student, number, source or sources[student])
+    out = base / "out" / "grades.csv"
+    command = [sys.executable, "-m", "ikteach.course.grade", str(subs), "--out", str(out),
+               "--timeout", "30", "--grade-timeout", "60", "--jobs", "2"]
+    run = subprocess.run(command + ([] if SANDBOXED else ["--no-sandbox"]), capture_output=True,
+                         text=True, timeout=900, cwd=base)
+    assert run.returncode == 0, run.stderr[-3000:]
+    rows = {r["student"]: r for r in csv.DictReader(out.open(encoding="utf-8"))}
+    feedback = {p.stem: p.read_text(encoding="utf-8") for p in (base / "out" / "feedback").glob("*.txt")}
+    return rows, feedback, run.stdout
+
+
+def test_the_honest_student_keeps_full_marks_and_is_not_reported(graded):
+    rows, feedback, _ = graded
+    assert [float(rows["honest"][f"ex{n}"]) for n in check.NUMBERS] == [10.0] * 7
+    assert float(rows["honest"]["total"]) == 70.0 and rows["honest"]["copied"] == ""
+    assert "for the instructor" not in feedback["honest"]
+
+
+@pytest.mark.parametrize("student, number, source, marks, line, copied", SPELLINGS)
+def test_each_spelling_of_ikteachs_answer(graded, student, number, source, marks, line, copied):
+    rows, feedback, _ = graded
+    row = rows[student]
+    assert float(row[f"ex{number}"]) == marks and float(row["total"]) == marks, feedback[student]
+    assert line in feedback[student], feedback[student]
+    if copied:
+        assert row["copied"].startswith(f"ex{number}: `") and line in row["copied"], row
+        assert "for the instructor: " in feedback[student]
+        assert "the marks stand until the instructor decides" in feedback[student]
+    else:
+        assert row["copied"] == "", row
+
+
+def test_the_log_records_the_hidden_cases_seed(graded):
+    _, _, log = graded
+    assert "hidden cases: seed " in log and "--seed " in log
