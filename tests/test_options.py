@@ -64,3 +64,14 @@ def test_tracking_refuses_stop_rules_it_never_uses():
 def test_not_an_options_object_is_refused():
     with pytest.raises(ValueError, match="options: expected ik.Options"):
         ik.solve(ARM, [2.0, 1.0], START, options={"tol": 1e-3})
+
+
+def test_a_fixed_alpha_is_a_parameter_of_the_jacobian_transpose():
+    """ik.JT(alpha=a) is the step a * J^T e (lecture 02's fixed step), as the step function."""
+    target = np.array([2.0, 1.0])
+    by_method = ik.solve(ARM, target, START, method=ik.JT(alpha=0.1), max_iter=300)
+    by_function = ik.solve(ARM, target, START, method=lambda J, e: 0.1 * (J.T @ e), max_iter=300)
+    assert (by_method.status, by_method.iterations) == (by_function.status, by_function.iterations)
+    np.testing.assert_allclose(by_method.theta, by_function.theta, atol=1e-12)
+    with pytest.raises(ValueError, match="alpha: expected a number >= 0"):
+        ik.JT(alpha=-1.0)

@@ -2,6 +2,7 @@
 import jax
 import jax.numpy as jnp
 
+from ._validate import as_number
 from .method import JacobianMethod, method
 
 
@@ -24,9 +25,17 @@ def jt_step(J, e):
     return optimal_alpha(J, e) * (J.T @ e)
 
 
-@method(data=())
+@method(data=("alpha",))
 class JT(JacobianMethod):
-    """The Jacobian transpose with Buss's optimal alpha (no parameters)."""
+    """The Jacobian transpose: delta_theta = alpha J^T e with Buss's optimal alpha, or with a
+    fixed step length alpha when one is given (lecture 02 compares the two)."""
+    alpha: float = None
+
+    def __post_init__(self):
+        if self.alpha is not None:
+            object.__setattr__(self, "alpha", as_number(self.alpha, "alpha", minimum=0))
 
     def step(self, J, e):
-        return jt_step(J, e)
+        if self.alpha is None:
+            return jt_step(J, e)
+        return self.alpha * (J.T @ e)
