@@ -22,6 +22,13 @@ def _count(event, duration, **kwargs):
 monitoring.register_event_duration_secs_listener(_count)
 
 
+@pytest.fixture(autouse=True)
+def no_program_bound(monkeypatch):
+    """The bound on compiled programs (ikteach/_runtime/jit.py) off: a worker that compiled many
+    programs in earlier test files would otherwise clear JAX's caches in the middle of a count."""
+    monkeypatch.setenv("IKTEACH_MAX_PROGRAMS", "0")
+
+
 def varied_solves(rng, count):
     """count solves cycling through the methods with varied targets and settings."""
     results = []

@@ -10,7 +10,7 @@ import pytest
 import ikteach as ik
 from ikteach.course import check
 from ikteach.course.grading.cells import only_checks
-from ikteach.course.grading.extract import code_cells
+from ikteach.course.grading.extract import code_cells, python_source
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES = {1: "_jacobian_cases", 2: "_jt_cases", 3: "_pinv_cases", 4: "_dls_cases",
@@ -61,7 +61,7 @@ def solution(number):
     namespace = {}
     for cell, source in code_cells(json.loads(path.read_text())):
         if not only_checks(source):
-            exec(compile(source, f"<cell {cell}>", "exec"), namespace)
+            exec(compile(python_source(source), f"<cell {cell}>", "exec"), namespace)
     return namespace
 
 
@@ -113,7 +113,7 @@ def notebook_functions(path):
     namespace = {}
     for cell, source in code_cells(json.loads(path.read_text())):
         if not only_checks(source):
-            exec(compile(source, f"<cell {cell}>", "exec"), namespace)
+            exec(compile(python_source(source), f"<cell {cell}>", "exec"), namespace)
     return namespace
 
 

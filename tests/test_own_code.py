@@ -17,7 +17,7 @@ import pytest
 import ikteach
 from ikteach.course import check
 from ikteach.course.grading import reference, selfcheck
-from ikteach.course.grading.extract import code_cells
+from ikteach.course.grading.extract import code_cells, python_source
 
 PACKAGE = Path(ikteach.__file__).resolve().parent
 ROOT = PACKAGE.parent
@@ -110,7 +110,8 @@ def test_a_copy_of_the_references_code_is_reported_a_students_own_is_not():
     for number in sorted(check.EXERCISES):  # the instructor's solutions: their own code
         path = next((ROOT / "instructor" / "solutions").glob(f"{number:02d}_*.ipynb"))
         cells = code_cells(json.loads(path.read_text()))
-        found = reference.fingerprints([compile(c, f"<cell {n}>", "exec") for n, c in cells])
+        found = reference.fingerprints([compile(python_source(c), f"<cell {n}>", "exec")
+                                        for n, c in cells])
         assert reference.copied(found, known(number)) == [], number
 
 

@@ -2,8 +2,8 @@
 import jax
 import jax.numpy as jnp
 
-from ._validate import as_number
-from .method import JacobianMethod, method
+from ikteach.core._validate import as_number  # absolute: the self-check runs this file as a cell
+from ikteach.core.method import JacobianMethod, method
 
 
 @jax.jit
