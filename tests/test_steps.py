@@ -73,3 +73,16 @@ def test_clamp_error_and_cap_step():
     np.testing.assert_allclose(ik.clamp_error(e, np.inf), e)
     np.testing.assert_allclose(ik.cap_step(np.array([0.2, -1.0]), 0.5), [0.1, -0.5])
     np.testing.assert_allclose(ik.cap_step(np.array([0.2, -0.3]), 0.5), [0.2, -0.3])
+
+
+@pytest.mark.parametrize("m", [1, 2, 3])
+def test_the_small_dls_step_is_dls_step(m):
+    """Cramer's rule (lecture 04) gives the LU solve's step to rounding, for m <= 3 rows."""
+    rng = np.random.default_rng(m)
+    for _ in range(20):
+        J, e = rng.normal(size=(m, 6)), rng.normal(size=m)
+        for lam in (0.01, 0.5):
+            np.testing.assert_allclose(ik.core.dls.dls_step_small(J, e, lam), ik.dls_step(J, e, lam),
+                                       rtol=1e-9, atol=1e-12)
+    singular = np.zeros((m, 6))
+    assert not np.all(np.isfinite(ik.core.dls.dls_step_small(singular, np.ones(m), 0.0)))

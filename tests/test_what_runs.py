@@ -17,7 +17,7 @@ SPATIAL = ik.serial_chain([[0, 0, 1], [0, 1, 0], [1, 0, 0], [0, 1, 0]],
 PRINTED = {
     "jt": ((jt, "jt_step"), (jt, "jt_step")),                    # lecture 02
     "pinv": ((pinv, "pinv_two_rows"), (pinv, "pinv_step")),      # lecture 03 prints both
-    "dls": ((dls, "dls_step"), (dls, "dls_step")),               # lecture 04
+    "dls": ((dls, "dls_step_small"), (dls, "dls_step_small")),   # lecture 04 prints both
     "sdls": ((sdls, "sdls_step"), (sdls, "sdls_step")),          # lecture 08
     "ccd": ((ccd, "ccd_angle"), (ccd, "ccd_angle")),             # lecture 08
     "fabrik": ((fabrik, "fabrik_forward"), (fabrik, "fabrik_forward")),  # lecture 08
