@@ -39,7 +39,7 @@ def same_types(new, old):
 
 def host_state(state):
     """A state as numpy values of fixed dtypes (no small device programs to build it)."""
-    return jax.tree_util.tree_map(lambda x: np.asarray(x, dtype=np.result_type(x)), state)
+    return jax.tree_util.tree_map(np.asarray, state)
 
 
 def until_stopped(step, args, state):

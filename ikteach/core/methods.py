@@ -88,31 +88,31 @@ def as_method(method, **parameters):
                      f"function step(J, e) -> delta_theta, got {method!r:.80}")
 
 
-def traceable(method, problem, theta0):
-    """Can JAX trace the method's step here (pure jax.numpy), or must it run eagerly?
-    Methods written in JAX say so (is_jax); a user's step function is tried."""
+def trace_failure(method, problem, theta0):
+    """None when JAX can trace the method's step at theta0 (methods written in JAX say so:
+    is_jax); else the error tracing a user's step function raised (a ValueError of ours is
+    raised as it is)."""
     if method.is_jax:
-        return True
+        return None
     try:
         jax.eval_shape(lambda q: method.delta(problem, q, problem.error(q), problem.jacobian(q)),
                        theta0)
-        return True
+        return None
     except ValueError:
         raise
-    except Exception:
-        return False
+    except Exception as err:
+        return err
+
+
+def traceable(method, problem, theta0):
+    """Can JAX trace the method's step here (pure jax.numpy), or must it run eagerly?"""
+    return trace_failure(method, problem, theta0) is None
 
 
 def require_traceable(method, problem, theta0, caller):
     """A ValueError naming `method` when `caller` (which compiles the step) cannot trace it."""
-    if method.is_jax:
-        return
-    try:
-        jax.eval_shape(lambda q: method.delta(problem, q, problem.error(q), problem.jacobian(q)),
-                       theta0)
-    except ValueError:
-        raise
-    except Exception as err:
+    err = trace_failure(method, problem, theta0)
+    if err is not None:
         raise ValueError(f"method: {caller} compiles the step function (jax.jit, jax.vmap), so "
                          f"its step functions must use jax.numpy, not numpy or Python branches "
                          f"on values (ik.solve runs either kind); JAX said: "

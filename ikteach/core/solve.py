@@ -110,7 +110,7 @@ def explain_stalls(problem, method, options, targets, thetas, status):
     inner = getattr(method, "inner", method)  # within joint limits: the method inside
     levels = None
     if hasattr(inner, "rows_by_level") and stalled.any():
-        rows = np.shape(problem.error(jnp.asarray(np.asarray(thetas)[0])))[0]
+        rows = jax.eval_shape(problem.error, np.asarray(thetas)[0]).shape[0]
         levels = tuple(tuple(int(i) for i in r) for r in inner.rows_by_level(rows))
     own_update = not method.uses_jacobian and not np.isfinite(options.max_step)
     kinds = stop_rules.why_stalled(problem.task, problem.arm, targets, thetas, stalled, options,

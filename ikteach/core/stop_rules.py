@@ -60,7 +60,6 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .levels import block_size
 from .priority import multilevel_step, null_projector
 from .safeguards import cap_step
 from .._runtime import jit as runtime_jit

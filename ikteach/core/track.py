@@ -6,6 +6,7 @@ over end effectors of the distance to its target after the step, and the joint m
 """
 import dataclasses
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 
@@ -71,8 +72,9 @@ def track(arm, targets, theta0=None, method="dls", options=None, *, damping=None
     Paths of any length run one compiled program (engine.SCAN_CHUNK steps at a time).
     """
     options = as_options(options, option_values)
+    defaults = Options()
     for name in ("tol", "max_iter", "stall_tol", "stop_rule"):
-        if getattr(options, name) != getattr(Options(), name):
+        if getattr(options, name) != getattr(defaults, name):
             raise ValueError(f"{name}: ik.track takes one step per time step and never stops "
                              f"early, so it has no {name}")
     if clamp_growth not in (True, False):
@@ -92,7 +94,7 @@ def track(arm, targets, theta0=None, method="dls", options=None, *, damping=None
         {"damping": damping, "rcond": rcond, "gamma_max": gamma_max}, rows="targets")
     require_traceable(method, problem, theta0, "ik.track")
     options = replace(options, tol=0.0, stall_tol=0.0, max_iter=np.int64(NEVER))
-    effectors = len(np.asarray(effector_errors(problem, jnp.asarray(theta0))))
+    effectors = jax.eval_shape(lambda q: effector_errors(problem, q), theta0).shape[0]
     d_max = np.full(effectors, options.clamp, dtype=float)
     first_clamp = np.full(effectors, np.inf) if clamp_growth else d_max
     args = (problem, method, options, d_max, np.asarray(bool(clamp_growth)))

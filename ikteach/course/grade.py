@@ -41,7 +41,6 @@ per student (FEEDBACK/<student>.txt, by default a `feedback` folder next to the 
 starts with what the sandbox enforces and what it cannot on this machine.
 """
 import argparse
-import csv
 import functools
 import json
 import os

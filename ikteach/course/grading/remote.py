@@ -18,7 +18,6 @@ import linecache
 import os
 import select
 import signal
-import sys
 import time
 import traceback
 
