@@ -14,7 +14,7 @@ export UV_PYTHON_DOWNLOADS := never
 # may not write them itself, e.g. PYTHONDONTWRITEBYTECODE, a read-only venv).
 SYNC := $(UV) sync --locked --inexact --extra dev --compile-bytecode
 
-.PHONY: lab test test-latest test-lowest lock lock-upgrade header notebooks strip bench clean exercises test-browser bench-browser site slides node_modules
+.PHONY: warm lab test test-latest test-lowest lock lock-upgrade header notebooks strip bench clean exercises test-browser bench-browser site slides node_modules
 
 # uv itself comes from PyPI, into the venv (the lock then keeps it at its locked version).
 $(UV):
@@ -38,6 +38,11 @@ $(LAB_STAMP): $(STAMP)
 lab: $(LAB_STAMP)
 	IKTEACH_PYVISTA=$${IKTEACH_PYVISTA:-interactive} \
 		$(VENV)/bin/jupyter lab --notebook-dir=notebooks $(LAB_ARGS)
+
+# Compile every lecture's solvers into the compilation cache before class (ikteach warm): each
+# lecture's first run then loads them instead of compiling.
+warm: $(STAMP)
+	$(VENV)/bin/ikteach warm
 
 # Exercise templates (check cells print "not yet implemented") and the instructor's solutions.
 EXERCISES = $(wildcard notebooks/exercises/*.ipynb) $(wildcard instructor/solutions/*.ipynb)

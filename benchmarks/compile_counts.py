@@ -12,15 +12,19 @@ import sys
 import tempfile
 from pathlib import Path
 
-from ikteach.course.warm import BUDGETS, count_programs, lectures
+from ikteach.course.warm import BUDGETS, ROOT, count_programs, lectures
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("notebooks", nargs="*", type=Path)
     ap.add_argument("--cold-only", action="store_true", help="skip the second (warm) run")
+    ap.add_argument("--exercises", action="store_true",
+                    help="the instructor's solutions too (each runs its exercise's checks)")
     args = ap.parse_args()
     paths = args.notebooks or lectures()
+    if args.exercises:
+        paths += sorted(ROOT.glob("instructor/solutions/*.ipynb"))
     print(f"| {'notebook':<30} | {'programs':>8} | {'budget':>6} | {'compile s':>9} | "
           f"{'trace s':>7} | {'cold s':>6} | {'warm s':>6} | {'loaded':>6} |")
     print(f"|{'-' * 32}|{'-' * 10}|{'-' * 8}|{'-' * 11}|{'-' * 9}|{'-' * 8}|{'-' * 8}|{'-' * 8}|")

@@ -14,9 +14,9 @@ METHODS = tuple(ik.core.methods.METHODS)
 COMPILES = []
 
 
-def _count(event, duration, **kwargs):
+def _count(event, duration, fun_name="?", **kwargs):
     if event.endswith("backend_compile_duration"):
-        COMPILES.append(event)
+        COMPILES.append(fun_name)
 
 
 monitoring.register_event_duration_secs_listener(_count)
@@ -150,3 +150,60 @@ def test_new_pose_weights_compile_nothing_new():
     assert len(COMPILES) == before, COMPILES[before:]
     assert len({r.iterations for r in [first, *results]}) > 1  # the weights did matter
     assert all(r.status == "converged" for r in results)
+
+
+def _programs_during(run):
+    """The names of the programs compiled while run() ran."""
+    before = len(COMPILES)
+    run()
+    return COMPILES[before:]
+
+
+def test_six_methods_on_a_new_arm_compile_one_loop_per_family():
+    """The method is data (ikteach/_runtime/shared.py): the Jacobian methods share one compiled
+    loop, CCD and FABRIK another; a second method, a new lambda or alpha compiles nothing."""
+    arm, start = ik.planar_chain([0.6] * 5), np.full(5, 0.1)  # a shape no other test uses
+    loops = [name for name in _programs_during(lambda: [
+        ik.solve(arm, [1.0, 2.0], start, method=m, max_iter=40) for m in METHODS])
+        if "traced_chunk" in name]
+    assert len(loops) == 2, loops
+    again = _programs_during(lambda: [
+        ik.solve(arm, [1.5, 1.0], start, method=ik.DLS(damping=0.3)),
+        ik.solve(arm, [1.5, 1.0], start, method=ik.Pinv(rcond=1e-3)),
+        ik.solve(arm, [1.5, 1.0], start, method=ik.SDLS(gamma_max=0.5)),
+        ik.track(arm, np.array([[1.0, 2.0], [1.1, 2.0]]), start, method="jt"),
+        ik.track(arm, np.array([[1.0, 2.0], [1.1, 2.0]]), start, method="sdls")])
+    assert [name for name in again if "traced_chunk" in name] == []
+    assert len([name for name in again if "scan" in name]) == 1, again  # the first track only
+
+
+def test_a_rest_gain_or_pose_weights_after_solves_without_them_compile_nothing():
+    ur5 = ik.core.robots.ur5()
+    start = np.full(6, 0.1)
+    target = np.asarray(ik.fk_pose(ur5, np.full(6, 0.3)))
+    ik.solve(ur5, target, start)
+    ik.solve(ARM, [1.5, 1.0], START, rest_pose=np.zeros(3))
+    assert _programs_during(lambda: [
+        ik.solve(ur5, target, start, weights=(1.0, 0.5)),
+        ik.solve(ur5, target, start, weights=(2, 1)),
+        ik.solve(ARM, [1.5, 1.0], START, rest_pose=np.zeros(3), rest_gain=0.2),
+        ik.solve(ARM, [1.2, 1.0], START, rest_pose=np.ones(3), rest_gain=1)]) == []
+
+
+def test_batch_sizes_in_one_bucket_share_a_program():
+    """solve_batch pads a batch to the next power of two (engine.bucket) and traces the count:
+    9 to 16 targets run one program, 17 to 32 the next; the padding is never solved."""
+    from ikteach._runtime.engine import bucket
+
+    assert [bucket(n) for n in (9, 16, 17, 100, 1000, 1025)] == [16, 16, 32, 128, 1024, 2048]
+    arm, start = ik.planar_chain([0.7] * 4), np.full(4, 0.2)  # a shape no other test uses
+    targets = np.random.default_rng(4).uniform(-2.0, 2.0, size=(32, 2))
+    first = _programs_during(lambda: ik.solve_batch(arm, targets[:9], start, stall_tol=0))
+    assert len([name for name in first if "queue" in name]) == 1, first
+    rest = _programs_during(lambda: [ik.solve_batch(arm, targets[:n], start, stall_tol=0)
+                                     for n in (10, 13, 16)])
+    assert [name for name in rest if "queue" in name] == []
+    whole = ik.solve_batch(arm, targets[:16], start, stall_tol=0)
+    part = ik.solve_batch(arm, targets[:10], start, stall_tol=0)
+    np.testing.assert_array_equal(part.theta, whole.theta[:10])
+    np.testing.assert_array_equal(part.iterations, whole.iterations[:10])

@@ -191,7 +191,7 @@ def stall_kind(task, arm, target, theta, lower, upper, levels=None, tol=0.0):
 STALL_BLOCKS = (8, 1024)  # rows per call: a solve's, a batch's
 
 
-@partial(runtime_jit.jit, static_argnames=("task", "levels"))
+@partial(runtime_jit.jit, static_argnames=("levels",))  # the task is a pytree: new weights reuse it
 def _stall_kinds(task, arm, targets, thetas, lower, upper, levels, tol):
     return jax.vmap(lambda t, q: stall_kind(task, arm, t, q, lower, upper, levels, tol))(targets, thetas)
 

@@ -1,0 +1,36 @@
+"""Each lecture's Run All needs at most its budget of XLA programs (ikteach/course/warm.py:
+BUDGETS; the table is in docs/maintainers.md). Programs are counted with JAX's own compile
+events, whether a program is compiled or loaded from the persistent cache, so the count does
+not depend on what this machine has cached, nor on its speed."""
+import re
+from pathlib import Path
+
+import pytest
+
+from ikteach.course.warm import BUDGETS, count_programs, lectures
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_every_lecture_has_a_budget_and_every_budget_a_lecture():
+    assert {path.stem for path in lectures()} == set(BUDGETS)
+
+
+def test_the_maintainers_table_states_the_budgets():
+    text = (ROOT / "docs" / "maintainers.md").read_text()
+    for name, budget in BUDGETS.items():
+        row = re.search(rf"^\| `{name}` \|[^|]*\| *{budget} *\|", text, re.MULTILINE)
+        assert row, f"docs/maintainers.md: no row for {name} with budget {budget}"
+
+
+@pytest.mark.parametrize("path", lectures(), ids=lambda p: p.stem)
+def test_a_lecture_compiles_within_its_budget(path):
+    counts = count_programs(path, cache=_cache())
+    assert 0 < counts["programs"] <= BUDGETS[path.stem], counts["by_name"]
+
+
+def _cache():
+    """The per-user cache the notebooks use (loading counts as a program too)."""
+    from ikteach.course.notebook import default_cache_dir
+
+    return default_cache_dir() or "off"
