@@ -140,3 +140,29 @@ def test_a_chaotic_run_may_drift_beyond_the_last_bits_but_not_in_status():
         assert (one.status, one.iterations) == (rows.status[k], rows.iterations[k])
         drift.append(np.abs(one.theta - rows.theta[k]).max())
     assert max(drift) < 1e-8, drift
+
+
+def test_the_accelerator_path_gives_the_queues_statuses_and_iterations():
+    """On a GPU the whole batch is in flight (engine._run_all: a vmap of the loop, padding rows
+    idle); run here on the CPU it ends every row as the queue does."""
+    from ikteach._runtime import engine
+    from ikteach.core.loop import start
+
+    rng = np.random.default_rng(11)
+    targets = rng.uniform(-3.5, 3.5, size=(13, 2))
+    queued = ik.solve_batch(ARM, targets, START, method="dls", max_iter=300)
+    problem, method, options, theta0, targets = ik.core.solve.prepare(
+        ARM, targets, START, "dls", ik.Options(max_iter=300), {}, rows="targets")
+    size = engine.bucket(len(targets))
+    pad = lambda x: engine._padded(x, size)
+    starts = np.broadcast_to(theta0, (len(targets), 3))
+    state = engine._run_all(batch.iterate_row, start, engine.as_data((problem, method, options)),
+                            pad(targets), pad(starts), np.int64(len(targets)))
+    status = np.asarray(state.status)
+    assert np.all(status[len(targets):] == -1)  # the padding never ran
+    names = np.asarray(ik.STATUSES, dtype=object)[status[: len(targets)]]
+    named_later = names == "stalled"  # explain_stalls names these after the loop
+    assert list(names[~named_later]) == list(queued.status[~named_later])
+    assert set(queued.status[named_later]) <= {"stalled", "singular", "damped", "fixed_point"}
+    np.testing.assert_array_equal(np.asarray(state.i)[: len(targets)], queued.iterations)
+    np.testing.assert_allclose(np.asarray(state.theta)[: len(targets)], queued.theta, atol=1e-9)

@@ -27,7 +27,8 @@ from .shared import as_data
 
 RUNNING = 0  # the loop's status while it runs (ikteach/core/loop.py)
 TRACE_CHUNK = 256  # passes per compiled run when the trace is kept
-SLOTS = 1024  # targets in flight at once (per device)
+SLOTS = 1024  # targets in flight at once on a CPU device (what one core's caches hold)
+GPU_SLOTS = 1 << 22  # on a GPU or TPU: the whole batch, up to this many (4 M)
 SPLIT_FROM = 512  # targets per device below which a batch stays on one device
 MIN_BUCKET = 16  # the smallest padded batch (ikteach/core/batch.py runs up to 8 one by one)
 STEPS_PER_REFILL = 4  # passes between refills (a refill costs more than a pass)
@@ -148,6 +149,17 @@ def _queue(step, start, args, rows, starts, count, slots):
 _run_queue = partial(runtime_jit.jit, static_argnames=("step", "start", "slots"))(_queue)
 
 
+@partial(runtime_jit.jit, static_argnames=("step", "start"))
+def _run_all(step, start, args, rows, starts, count):
+    """Every row in flight at once (an accelerator's whole batch): jax.vmap of the loop, the
+    padding rows (index >= count) idle from the start."""
+    def one(index, row, theta0):
+        state = start(theta0)
+        state = state._replace(status=jnp.where(index < count, state.status, -1))
+        return until_stopped(step, (args, row), state)
+    return jax.vmap(one)(jnp.arange(starts.shape[0]), rows, starts)
+
+
 def _shard_map():
     """jax.shard_map and the keyword that turns its replication check off (older jax: the
     experimental one); None when this jax has neither."""
@@ -191,6 +203,14 @@ def _padded(x, size):
     return np.concatenate([x, np.repeat(x[-1:], size - x.shape[0], axis=0)])
 
 
+def in_flight(size, device=None):
+    """How many of `size` rows a device keeps in flight: SLOTS on a CPU (a pass over more would
+    spill its caches), the whole batch up to GPU_SLOTS on an accelerator (it needs them all
+    to fill its cores; refills then never happen)."""
+    platform = (device or jax.local_devices()[0]).platform
+    return min(SLOTS if platform == "cpu" else GPU_SLOTS, size)
+
+
 def run_queue(step, start, args, rows, starts):
     """Final states of every row (numpy). The rows are padded to bucket(count), so batches of
     nearby sizes share one program. Over several devices, device k takes rows k, k + D,
@@ -200,8 +220,11 @@ def run_queue(step, start, args, rows, starts):
     if devices is None:
         size = bucket(count)
         pad = lambda x: _padded(x, size)
-        state = _run_queue(step, start, args, jax.tree_util.tree_map(pad, rows), pad(starts),
-                           np.int64(count), min(SLOTS, size))
+        rows, starts = jax.tree_util.tree_map(pad, rows), pad(starts)
+        if in_flight(size) == size and jax.local_devices()[0].platform != "cpu":
+            state = _run_all(step, start, args, rows, starts, np.int64(count))
+        else:
+            state = _run_queue(step, start, args, rows, starts, np.int64(count), in_flight(size))
         return jax.tree_util.tree_map(lambda x: np.asarray(x)[:count], jax.device_get(state))
     d = len(devices)
     share = bucket(-(-count // d))
@@ -209,7 +232,7 @@ def run_queue(step, start, args, rows, starts):
     counts = np.array([len(range(k, count, d)) for k in range(d)], dtype=np.int64)
     take = lambda x: np.asarray(x)[order]
     state = _run_split(step, start, args, jax.tree_util.tree_map(take, rows), take(starts),
-                       counts, min(SLOTS, share), _mesh(devices))
+                       counts, in_flight(share, devices[0]), _mesh(devices))
     back = np.arange(count)
     back = (back % d) * share + back // d  # where row r went
     return jax.tree_util.tree_map(lambda x: np.asarray(x)[back], state)
