@@ -1,5 +1,6 @@
 """A long session: 10,000 varied solves in one process (every built-in method, chains of 1-12
-joints, max_iter anywhere from 1 to 5,000, planar and spatial arms, a few batches), with the
+joints, max_iter anywhere from 1 to 5,000, planar and spatial arms, clamps, step caps, joint
+limits and rest poses, UR5 pose targets with varied weights, batches of varied sizes), with the
 memory mappings and resident memory it holds as it goes. Before issue 23 every new max_iter,
 joint count and method compiled a program of its own (about 140 mappings and 5 MB each) and a
 session like this one died at the system's limit on mappings (vm.max_map_count, 65530 on
@@ -49,6 +50,7 @@ def main():
     methods = tuple(ik.core.methods.METHODS)
     spatial = {n: ik.serial_chain(np.tile([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0]], (n, 1))[:n],
                                   [[0.0, 0.0, 0.3]] * n) for n in range(1, 13)}
+    ur5 = ik.core.robots.ur5()
     print(f"bound: {runtime_jit.max_programs() or 'none'} programs; "
           f"vm.max_map_count {open('/proc/sys/vm/max_map_count').read().strip()}")
     print(f"| {'solves':>7} | {'seconds':>8} | {'compiles':>8} | {'clears':>6} | "
@@ -66,13 +68,28 @@ def main():
         else:
             arm = ik.planar_chain(rng.uniform(0.2, 1.0, size=n))
             target = rng.uniform(-1.0, 1.0, size=2) * n * 0.6
-        if k % 500 == 0:
-            res = ik.solve_batch(arm, rng.uniform(-1, 1, size=(64, arm.dim)) * n * 0.6,
-                                 np.zeros(n), method=method, max_iter=max_iter)
+        options = {}
+        if k % 3 == 0:
+            options["clamp"] = float(rng.choice([0.1, 0.5])) * n
+        if k % 5 == 0:
+            options["max_step"] = float(rng.choice([0.1, 0.3]))
+        if k % 13 == 0 and method not in ("ccd", "fabrik"):
+            options["joint_limits"] = (-2.0, 2.0)
+        if k % 17 == 0 and method == "dls":
+            options["rest_pose"] = np.zeros(n)
+            options["rest_gain"] = float(rng.uniform(0.05, 0.5))
+        if k % 11 == 0 and method not in ("ccd", "fabrik"):
+            target = np.asarray(ik.fk_pose(ur5, rng.uniform(-1.5, 1.5, size=6)))
+            status = ik.solve(ur5, target, np.full(6, 0.1), method=method, max_iter=max_iter,
+                              weights=tuple(rng.uniform(0.2, 2.0, size=2))).status
+        elif k % 250 == 0:
+            size = int(rng.integers(9, 700))
+            res = ik.solve_batch(arm, rng.uniform(-1, 1, size=(size, arm.dim)) * n * 0.6,
+                                 np.zeros(n), method=method, max_iter=max_iter, **options)
             status = res.status[0]
         else:
             status = ik.solve(arm, target, rng.uniform(-1, 1, size=n), method=method,
-                              max_iter=max_iter).status
+                              max_iter=max_iter, **options).status
         statuses[status] = statuses.get(status, 0) + 1
         if k % (args.solves // 10) == 0:
             print(f"| {k:>7,} | {time.perf_counter() - t0:>8.1f} | {len(compiles):>8} | "

@@ -28,16 +28,16 @@ ROOT = Path(__file__).resolve().parents[2]
 # Programs each lecture's Run All may need (compiled or loaded from the cache); a test fails
 # above these. The counts are deterministic: docs/maintainers.md has the table.
 BUDGETS = {
-    "01_jacobian": 12,
-    "02_jacobian_transpose": 12,
-    "03_pseudoinverse": 12,
-    "04_damped_least_squares": 16,
-    "05_singularities_and_reach": 24,
-    "06_pose_targets": 20,
-    "07_workspace_maps": 20,
-    "08_trees_and_sdls": 24,
-    "09_characters": 24,
-    "10_redundancy": 24,
+    "01_jacobian": 19,
+    "02_jacobian_transpose": 29,
+    "03_pseudoinverse": 25,
+    "04_damped_least_squares": 49,
+    "05_singularities_out_of_reach": 117,
+    "06_pose_targets_3d": 53,
+    "07_workspace_maps": 11,
+    "08_methods_compared": 28,
+    "09_characters": 27,
+    "10_redundancy": 44,
 }
 
 # Run in the kernel before the notebook's first cell: count JAX's own compile events.
