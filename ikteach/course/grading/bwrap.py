@@ -201,6 +201,8 @@ def judge(seen, escaped, hidden):
         failures.append("it could reach the grader's machine over the network")
     if seen.get("mounted"):
         failures.append("it could mount a file system")
+    if seen.get("kernel_settings"):
+        failures.append(f"it could open {', '.join(seen['kernel_settings'])} for writing")
     server = seen.get("server")
     if not isinstance(server, dict) or any(server.values()) or not server:
         failures.append(f"it could reach the fork server that starts every notebook ({server})")
@@ -220,6 +222,9 @@ def judge(seen, escaped, hidden):
                      "and what they wrote removed")
     lines.append("cannot ptrace, read the memory of, or stop the fork server that starts every "
                  "notebook in a fresh child")
+    if seen.get("oom_lowered") is False:
+        lines.append("cannot write /proc or /sys: the kernel's settings (/proc/sys "
+                     "read-only, tried core_pattern) nor its own OOM priority (Landlock)")
     if seen.get("userns_blocked"):
         lines.append("cannot create user namespaces (so it cannot regain capabilities)")
     if seen.get("new_session") is False:

@@ -5,11 +5,14 @@ Backend: bubblewrap (`bwrap`; Debian/Ubuntu/Fedora/Arch package `bubblewrap`), s
 run sees a read-only whitelist of the machine (system libraries, a few files of /etc, the
 Python the grader runs on, ikteach's package without its checker) and its own working folder;
 /tmp private; no network; own PID, IPC and UTS namespaces; its own user namespace as an
-unprivileged uid with no capabilities, also when the grader runs as root.
+unprivileged uid with no capabilities, also when the grader runs as root; /proc/sys and the other
+parts of /proc that write to the machine's kernel read-only, and (Landlock, forkserver.py) no
+file outside its folders, /tmp and /dev/shm opens for writing: not its own oom_score_adj.
 What a run writes lives in memory, size-limited (tmpfs: /tmp, /dev/shm, its working folder;
 /dev read-only); POSIX message queues show in /dev/mqueue, so the fork server removes a job's;
-seccomp refuses new sessions (one scheduler autogroup per sandbox, not one per busy child) and
-the kernel keyrings (not namespaced).
+seccomp refuses new sessions (one scheduler autogroup per sandbox, not one per busy child), the
+kernel keyrings (not namespaced), file locks and inotify (a lock or a watch on a file every
+sandbox sees is a channel between jobs that run at once).
 Always: own HOME, bare environment (BLAS kernel variables passed through, so that the student's
 numbers come from the same kernels as the grader's), resource limits (CPU time, address space,
 file size, no core files), its own process group (ended as a whole, from outside), the OOM
@@ -18,8 +21,8 @@ process may make cgroups (v1 pids/memory/cpu, or v2), one per sandbox: processes
 memory of its processes and files together, an equal CPU share; else RLIMIT_NPROC (not for
 root).
 Student code runs in jobs of a fork server started in the sandbox (servers.py, forkserver.py):
-one bubblewrap per server, a fresh child per notebook run or checks' worker, everything of a job
-killed and removed when it ends. `Sandbox.verify()` runs a probe as such a job and `report()`
+one bubblewrap per server, a fresh child per notebook (its cells, then its checks' calls),
+everything of a job killed and removed when it ends; a server a job changed is replaced. `Sandbox.verify()` runs a probe as such a job and `report()`
 states only what the probe saw hold.
 """
 import dataclasses
@@ -229,6 +232,9 @@ class Sandbox:
             yes.append("visible, read-only, by its mount list (probed only as above): the "
                        "system libraries, the grader's Python, ikteach's package without its "
                        "checker; nothing else of this machine")
+            if not any(line.startswith("cannot write /proc") for line in self.verified):
+                no.append("a job's own OOM priority and /proc files it owns (no Landlock in "
+                          "this kernel): it can lower its oom_score_adj")
             no.append("a kernel exploit (bubblewrap shares this machine's kernel)")
         else:
             no += [f"ISOLATION: NONE ({OVERRIDE}): students' code runs with this user's rights",
