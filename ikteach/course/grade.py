@@ -168,7 +168,7 @@ def _run(number, book, sandbox, timeout, grade_timeout, seed=None):
         try:
             worker.start()
         except (ProcessEnded, ValueError) as exc:  # died, hung, or answered garbage
-            return None, worker.errors + worker.notes + [f"nothing could be graded: {exc}"], []
+            return None, worker.errors + (worker.notes or [f"nothing could be graded: {exc}"]), []
         notes = worker.errors + worker.notes
         copied = _copied(number, book, worker.held)
         if worker.foreign:  # a graded name bound to ikteach's (or anyone's) code: no marks

@@ -21,6 +21,7 @@ STARTUP_LIMIT = 120.0    # seconds for the job to start (the fork server's fork:
 CALL_LIMIT = 600.0       # last-resort limit on one reply (the checks' own limit is shorter)
 MAX_REPLY = 64 << 20     # bytes
 MAX_NOTES, MAX_NAMES, MAX_HELD = 30, 200, 200
+GRACE = 15.0             # seconds past the cells' own alarm before the job is killed
 
 
 class ProcessEnded(Exception):
@@ -181,22 +182,19 @@ class Worker:
         then say which cell it was in)."""
         from .servers import server_for
 
-        grace = min(15.0, self.timeout)  # after the job's own alarm: killed from outside
-        self.deadline = time.monotonic() + self.timeout + grace + STARTUP_LIMIT
+        # after the job's own alarm: killed from outside (`grace` also for its start-up)
+        grace = min(GRACE, self.timeout) + GRACE
+        self.deadline = time.monotonic() + self.timeout + grace
         self.process = server_for(self.sandbox, self.exercise).job(
-            "notebook", self.timeout + grace + STARTUP_LIMIT + self.limit, self.setup)
+            "notebook", self.timeout + grace + self.limit, self.setup)
         cell = None
         try:
             while True:
                 try:
-                    message = self._read(self.deadline - time.monotonic())
-                except ProcessEnded:
-                    if cell is None:
-                        self.notes.append("the notebook's run ended before its first cell")
-                    else:
-                        self.notes.append(f"the notebook's run ended in cell {cell} (a "
-                                          "crash, os._exit, a CPU, memory or file-size limit, "
-                                          "or its time limit with the alarm ignored)")
+                    message = self._read(self.deadline - time.monotonic(), during="cells")
+                except ProcessEnded as exc:
+                    where = "before its first cell" if cell is None else f"in cell {cell}"
+                    self.notes.append(f"the notebook's run ended {where}: {exc}")
                     raise
                 if not isinstance(message, dict):
                     continue
@@ -208,7 +206,7 @@ class Worker:
                     self.notes.append(f"cell {str(message['stopped'])[:20]} did not finish "
                                       "within the notebook's time limit "
                                       f"({self.timeout:g} s): it was stopped there")
-                cell = message.get("cell", cell)
+                cell = str(message["cell"])[:20] if "cell" in message else cell
         except BaseException:
             self.end()
             raise
@@ -225,14 +223,18 @@ class Worker:
     def _write(self, message):
         self.process.write((json.dumps(message) + "\n").encode())
 
-    def _read(self, timeout):
+    def _read(self, timeout, during="checks"):
         """The job's next message (one JSON line), waiting at most `timeout` s and never past
-        the deadline."""
+        the deadline (of the cells or of the checks: `during`)."""
         fd = self.process.fileno()
         while b"\n" not in self._buffer:
             left = self.deadline - time.monotonic()
             ready, _, _ = select.select([fd], [], [], max(0.0, min(timeout, left)))
             if not ready:
+                if left <= timeout and during == "cells":
+                    raise ProcessEnded("it did not finish within the notebook's time limit "
+                                       f"({self.timeout:g} s) and ignored the alarm: it was "
+                                       "killed, and nothing could be graded")
                 if left <= timeout:
                     raise ProcessEnded(f"your code ran past the grading time limit of "
                                        f"{self.limit:g} s: it was stopped")
