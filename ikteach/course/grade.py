@@ -7,40 +7,45 @@
     python -m ikteach.course.grade --gradescope OUT.zip      (a Gradescope autograder bundle)
 
 SUBMISSIONS_DIR holds one folder per student (the folder name is the student), each with that
-student's exercise notebooks (NN_name.ipynb, as handed out). For each notebook:
+student's exercise notebooks. A notebook is taken for an exercise by its metadata, else its
+content (the functions it defines, the check it calls), else an NN_ in its name (identify()).
+Each notebook is one job, in a sandbox (ikteach.course.grading.sandbox: bubblewrap, an
+unprivileged user without capabilities, no network, a read-only whitelist of the machine,
+resource limits; where no sandbox works the grader refuses unless --no-sandbox):
 
-1. its cells run in IPython's shell in a sandbox (ikteach.course.grading.sandbox: bubblewrap,
-   an unprivileged user without capabilities, no network, a read-only whitelist of the
-   machine, resource limits; where no sandbox works the grader refuses unless --no-sandbox),
-   for its errors and notes only - nothing it prints counts;
-2. the student's functions are taken from the notebook's source (top-level imports,
-   definitions and assignments, by the AST) into a second sandboxed process, and ik.check runs
-   in the grader's own process, calling them there through a pipe (each call under its time
-   limit), on hidden cases: the instant check's kinds with numbers drawn from a seed at
-   grading time (logged; --seed repeats a run). So nothing a notebook does to modules,
-   builtins, stdout or files changes a score. A graded name that is not a function written
-   in the notebook gets 0 (grading/own_code.py).
-Both processes see a copy of ikteach in which the exercise's reference answers are stubs that
-raise, without the checker and the self-check (grading/reference.py: what the grader
-guarantees and what it only reports - code copied from ikteach, in grades.csv's `copied`).
-They are fresh children of a fork server (grading/forkserver.py: one per sandbox, exercise and
-grading process, Python, JAX and ikteach imported once), which no student code ever ran in;
-after each, every process of the sandbox but the server is killed and what they wrote removed,
-so no notebook starts from a state another one touched.
+1. its code cells run in IPython's shell, as a kernel runs them (grading/cells.py); their
+   errors are notes, nothing they print counts;
+2. then ik.check runs in the grader's own process on hidden cases (the instant check's kinds
+   with numbers drawn from a seed at grading time, logged; --seed repeats a run), calling the
+   functions the cells left in the shell's namespace through a pipe, each call under its time
+   limit (grading/remote.py). So nothing a notebook does to modules, builtins, stdout or
+   files changes a score. A graded name that is not a function written in the notebook gets 0
+   (grading/own_code.py). A check that ran past its time limit is run again in a fresh job
+   before the timeout counts (a busy machine, a first compile).
+The job sees a copy of ikteach in which the exercise's reference answers are stubs that raise,
+without the checker and the self-check (grading/reference.py: what the grader guarantees and
+what it only reports - code copied from ikteach, in grades.csv's `copied`). It is a fresh child
+of a fork server (grading/forkserver.py: one per sandbox, exercise and grading process, Python,
+JAX and ikteach imported once), which no student code ever ran in; after each job every process
+of the sandbox but the server is killed and what they wrote removed, and a server the job
+changed (its files, limits or priorities) is replaced, so no notebook starts from a state
+another one touched.
 
 Before anyone is graded the sandbox is probed (the log states only what the probe saw hold)
 and a known-good answer must get full marks (grading/selfcheck.py); if either fails the grader
 stops with a non-zero exit status. The submissions folder is not trusted (grading/submissions.py):
 a symlink, FIFO, directory or malformed notebook costs only its student's marks, with a reason
-in the CSV's `notes`. Each notebook's cells get --timeout seconds and its checks
---grade-timeout, both enforced from outside the student's process (the fork server kills every
-process of the job; the grader kills the whole sandbox if the server does not answer).
+in the CSV's `notes`. Each notebook's cells get --timeout seconds (then the running cell is
+interrupted) and its checks --grade-timeout, both also enforced from outside the student's
+process (the fork server kills every process of the job; the grader kills the whole sandbox if
+the server does not answer).
 
 Writes one CSV row per student (ex1..ex7, total, sandbox, notes, copied) and a feedback file
 per student (FEEDBACK/<student>.txt, by default a `feedback` folder next to the CSV); the log
 starts with what the sandbox enforces and what it cannot on this machine.
 """
 import argparse
+import dataclasses
 import functools
 import os
 import re
@@ -134,23 +139,16 @@ def _answer_text(book):
     return "\n".join(texts)[:4000]
 
 
-def _copied(number, book, held):
+def _copied(number, held):
     """Lines for the instructor: the notebook's functions whose code is exercise `number`'s
-    reference (compiled here from the source, and what the worker says it holds: a marshalled
-    or exec'd copy). Reported, never scored (grading/reference.py)."""
+    reference (`held`: the fingerprints of the code the notebook's namespace holds, computed
+    in its job, under its limits: nothing of a student's code is compiled here). Reported,
+    never scored (grading/reference.py)."""
     from . import check
     from .grading import reference
-    from .grading.extract import code_cells, without_magics
 
     known = reference.reference_fingerprints(check.EXERCISES[number].REFERENCES)
-    found = dict(held)
-    for cell, source in code_cells(book):
-        try:
-            found.update(reference.fingerprints([compile(without_magics(source), f"<cell {cell}>",
-                                                         "exec")]))
-        except (SyntaxError, ValueError, RecursionError, MemoryError):
-            continue  # not Python: the worker's notes say so
-    return reference.copied(found, known)
+    return reference.copied(held, known)
 
 
 def _run(number, book, sandbox, timeout, grade_timeout, seed=None):
@@ -170,7 +168,7 @@ def _run(number, book, sandbox, timeout, grade_timeout, seed=None):
         except (ProcessEnded, ValueError) as exc:  # died, hung, or answered garbage
             return None, worker.errors + (worker.notes or [f"nothing could be graded: {exc}"]), []
         notes = worker.errors + worker.notes
-        copied = _copied(number, book, worker.held)
+        copied = _copied(number, worker.held)
         if worker.foreign:  # a graded name bound to ikteach's (or anyone's) code: no marks
             return (check.registry.refuse(number, " ".join(worker.foreign.values())), notes,
                     copied)
@@ -284,7 +282,8 @@ def grade_all(submissions, out, feedback=None, timeout=NOTEBOOK_TIMEOUT, jobs=1,
     out = Path(out)
     feedback = Path(feedback) if feedback else out.parent / "feedback"
     hidden = [submissions, out.parent, feedback, INSTRUCTOR, Path.cwd() / "instructor"]
-    sandbox = Sandbox(hidden, limits or Limits(), bwrap=bwrap, unsandboxed=unsandboxed)
+    limits = dataclasses.replace(limits or Limits(), jobs=max(1, int(jobs)))
+    sandbox = Sandbox(hidden, limits, bwrap=bwrap, unsandboxed=unsandboxed)
     try:
         if sandbox.unsandboxed:
             (warn or (lambda m: print(m, file=sys.stderr)))(

@@ -3,7 +3,10 @@ start-up once and forks a fresh child for every job (a notebook's cells and then
 calls, cells.py; the start-up probe). Runs inside the sandbox (bubblewrap --as-pid-1: it is the PID namespace's
 init), started by servers.py:
 
-    python -m ikteach.course.grading.forkserver CONTROL_FD SANDBOXED(0|1)
+    python -m ikteach.course.grading.forkserver CONTROL_FD SANDBOXED(0|1) NPROC
+
+NPROC (0: leave it): the processes its sandbox may have (RLIMIT_NPROC, set by the server on
+itself before any job: sandbox.py's quota()).
 
 Each child starts from the server's state, which no student code ever ran in: the server only
 imports modules and never starts JAX's backend (so it has one thread, and a fork copies it
@@ -126,14 +129,18 @@ def _remove_ipc(libc):
 
 
 class Server:
-    def __init__(self, control, sandboxed):
-        self.control, self.sandboxed = control, sandboxed
+    def __init__(self, control, sandboxed, nproc=0):
+        self.control, self.sandboxed, self.nproc = control, sandboxed, nproc
         self.libc = _libc()
         self.home = os.getcwd()  # the server's own folder (bound read-write)
         self.pid1 = os.getpid() == 1
         self.baseline, self.state = None, None
 
     def start(self):
+        import resource
+
+        if self.nproc:  # this sandbox's user namespace: its own count of processes
+            resource.setrlimit(resource.RLIMIT_NPROC, (self.nproc, self.nproc))
         _prctl(self.libc, PR_SET_DUMPABLE, 0)
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         if not self.pid1:  # unsandboxed: orphans of a job come back here, to be ended
@@ -292,7 +299,7 @@ def main(argv):
         os.dup2(null, fd)
     try:
         preload()
-        server = Server(control, argv[1] == "1")
+        server = Server(control, argv[1] == "1", int(argv[2]) if len(argv) > 2 else 0)
         server.start()
         hello = {"ready": True, "threads": len(os.listdir("/proc/self/task")),
                  "pid": os.getpid(), "import_error": None}

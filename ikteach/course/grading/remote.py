@@ -14,6 +14,7 @@ import importlib
 import json
 import os
 import select
+import signal
 import time
 import traceback
 
@@ -22,6 +23,7 @@ CALL_LIMIT = 600.0       # last-resort limit on one reply (the checks' own limit
 MAX_REPLY = 64 << 20     # bytes
 MAX_NOTES, MAX_NAMES, MAX_HELD = 30, 200, 200
 GRACE = 15.0             # seconds past the cells' own alarm before the job is killed
+HELD_LIMIT = 5.0         # seconds for the fingerprints of the code a notebook holds
 
 
 class ProcessEnded(Exception):
@@ -128,13 +130,28 @@ def _student_line(exc):
     return ""
 
 
+class _TimeUp(BaseException):
+    pass
+
+
+def _time_up(signum, frame):
+    raise _TimeUp()
+
+
 def serve(namespace, graded, requests, send):
     """After the cells (cells.py): say what the namespace holds, then answer calls, one JSON
     line each, until the grader closes the requests."""
     from ikteach.core.solve import StopSolve
     from ikteach.course.grading import own_code, reference
 
-    held = reference.fingerprints(reference.held_code(namespace))  # reported, not trusted
+    signal.signal(signal.SIGALRM, _time_up)
+    signal.setitimer(signal.ITIMER_REAL, HELD_LIMIT)
+    try:  # reported, not trusted; under its own limit (a cell crafted to make it slow)
+        held = reference.fingerprints(reference.held_code(namespace))
+    except _TimeUp:
+        held = {}
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
     send({"ready": sorted(k for k, v in namespace.items() if callable(v) and k[:2] != "__"),
           "foreign": own_code.foreign(namespace, graded), "held": held})
     handles = []

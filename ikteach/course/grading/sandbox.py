@@ -65,6 +65,7 @@ class Limits:
     cpu_seconds: int = 600
     memory_mb: int = 4096
     processes: int = 256
+    jobs: int = 1  # sandboxes at once (the grader's --jobs): each gets its own process quota
     file_mb: int = 256
     tmpfs_mb: int = 256  # each of a sandbox's /tmp, /dev/shm and working folder
 
@@ -217,7 +218,10 @@ class Sandbox:
         if "pids" in has:
             yes.append(f"processes: at most {lim.processes} (cgroup pids.max)")
         elif not self.root:
-            yes.append(f"processes: at most {lim.processes} for this user (RLIMIT_NPROC)")
+            yes.append(f"processes: at most {lim.processes} per sandbox (RLIMIT_NPROC in its "
+                       "user namespace; the user's limit leaves room for every sandbox's)"
+                       if self.bwrap else
+                       f"processes: at most {lim.processes} for this user (RLIMIT_NPROC)")
         else:
             no.append("process count (root ignores RLIMIT_NPROC and the pids cgroup is not "
                       "writable): a fork storm is bounded only by the CPU and time limits")
@@ -273,12 +277,34 @@ class Sandbox:
         return sandbox_copy(self.package, folder / "ikteach", EXERCISES[exercise].REFERENCES,
                             exercise, base=self.package_for(None))
 
+    def quota(self):
+        """Processes of one sandbox, where it is bounded by RLIMIT_NPROC (an ordinary user
+        without a pids cgroup; 0: not so bounded)."""
+        return self.limits.processes if not self.root and "pids" not in self.controlled else 0
+
+    def outer_nproc(self):
+        """RLIMIT_NPROC from outside: this user's processes now plus every sandbox's quota.
+        Linux (5.14+) counts a user namespace's processes apart and also against the limit its
+        creator had: each sandbox's fork server lowers its own to quota(), so one sandbox's fork
+        storm stops at its quota, never at the user's, and a classmate's sandbox can still fork."""
+        if not self.quota():
+            return 0
+        uid, mine = os.getuid(), 0
+        for name in os.listdir("/proc"):
+            try:
+                mine += name.isdigit() and os.stat(f"/proc/{name}").st_uid == uid
+            except OSError:
+                continue
+        if not self.bwrap:
+            return self.limits.processes
+        return mine + self.limits.jobs * (self.quota() + 16) + 64
+
     def command(self, argv, work, cgroups, pid1=False, seccomp=None, package=None):
         """The full command line: launcher (limits), then bwrap (if any), then argv (`pid1`:
         as the init of its PID namespace; `seccomp`: the fd of bwrap's filter; `package`: the
         copy of ikteach it sees)."""
         lim = self.limits
-        nproc = lim.processes if (not self.root and "pids" not in self.controlled) else 0
+        nproc = self.outer_nproc()
         launch = [sys.executable, "-S", str(LAUNCH), str(lim.cpu_seconds),
                   str(lim.memory_mb << 20), str(lim.file_mb << 20), str(nproc),
                   ",".join(map(str, cgroups)) or "-", "--"]

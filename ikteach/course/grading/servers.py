@@ -63,7 +63,8 @@ class Server:
         try:
             self.process = sandbox.start(
                 [sys.executable, "-m", "ikteach.course.grading.forkserver", str(theirs.fileno()),
-                 "1" if sandbox.bwrap else "0"], self.dir, pid1=True, exercise=exercise,
+                 "1" if sandbox.bwrap else "0", str(sandbox.quota() if sandbox.bwrap else 0)],
+                self.dir, pid1=True, exercise=exercise,
                 pass_fds=(theirs.fileno(),),
                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         finally:
