@@ -9,12 +9,15 @@ Before each cell a line {"cell": N} goes to REPLIES, after a cell that raised {"
 raised Name: value"}. The cells get `timeout` seconds in all: then the running cell is
 interrupted (SIGALRM) and the rest skipped ({"stopped": N}); a notebook that ignores the alarm
 is killed from outside by the fork server and the grader. Then {"ready": ...} (remote.serve)
-and the calls. Code objects compile as `<cell N>` (tracebacks and grading/own_code.py name them).
+and the calls. Code objects compile as `<cell N>` (tracebacks and grading/own_code.py name them);
+a cell starting with %%time or %%capture runs as its body (their own compile names it otherwise).
 """
 import json
 import os
 import re
 import signal
+
+from .extract import cell_body
 
 MAX_TEXT = 300  # characters of an error message kept
 
@@ -61,7 +64,7 @@ def run(instance, cells, send, timeout):
                 continue
             send({"cell": number})
             instance.execution_count = number  # the <cell N> name (get_code_name's number)
-            result = instance.run_cell(source, store_history=False)
+            result = instance.run_cell(cell_body(source), store_history=False)
             exc = result.error_before_exec or result.error_in_exec
             if isinstance(exc, NotebookTime):
                 send({"stopped": number})

@@ -9,10 +9,17 @@ import re
 BODY_AS_PYTHON = re.compile(r"\s*%%(time|capture)\b[^\n]*(\n|$)")  # its body: plain cell code
 
 
-def python_source(source):
-    """Cell source with IPython syntax (magics, !shell) rewritten as plain Python."""
+def cell_body(source):
+    """The cell without a leading %%time or %%capture (which run their body as the cell's own
+    code: graded as that code, compiled as the cell's)."""
     while match := BODY_AS_PYTHON.match(source):
         source = source[match.end():]
+    return source
+
+
+def python_source(source):
+    """Cell source with IPython syntax (magics, !shell) rewritten as plain Python."""
+    source = cell_body(source)
     try:
         from IPython.core.inputtransformer2 import TransformerManager
     except ImportError:  # no IPython: drop the magic lines instead
@@ -23,8 +30,7 @@ def python_source(source):
 def without_magics(source):
     """Cell source with its magic and shell lines dropped (cheap: for the grader's own process,
     which reads the code but never runs it)."""
-    while match := BODY_AS_PYTHON.match(source):
-        source = source[match.end():]
+    source = cell_body(source)
     return "\n".join("" if line.lstrip().startswith(("%", "!")) else line
                      for line in source.splitlines())
 
