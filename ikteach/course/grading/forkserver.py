@@ -1,7 +1,7 @@
 """The fork server: one per sandbox and grading process, it pays Python's, JAX's and ikteach's
 start-up once and forks a fresh child for every job (a notebook's cells and then its checks'
-calls, cells.py; the start-up probe). Runs inside the sandbox (bubblewrap --as-pid-1: it is the PID namespace's
-init), started by servers.py:
+calls, cells.py; the start-up probe). Runs inside the sandbox (bubblewrap --as-pid-1: it is
+the PID namespace's init), started by servers.py:
 
     python -m ikteach.course.grading.forkserver CONTROL_FD SANDBOXED(0|1) NPROC
 
@@ -20,8 +20,9 @@ priority, CPU set or OOM score are not those it started with (a job may `prlimit
 same uid), it says `dirty` and the grader starts a fresh server: every job starts with the
 limits the grader set from outside. In the sandbox a job's child may write only beneath its
 folder, /tmp, /dev/shm and /dev's devices (Landlock, where the kernel has it: no /proc or /sys
-file, e.g. its own oom_score_adj or the kernel's settings, opens for writing). The server is not dumpable (no ptrace, no /proc/1/mem) and,
-as init, ignores every signal from inside the namespace that it has no handler for.
+file, e.g. its own oom_score_adj or the kernel's settings, opens for writing). The server is
+not dumpable (no ptrace, no /proc/1/mem) and, as init, ignores every signal from inside the
+namespace that it has no handler for.
 
 Control messages (JSON over a SOCK_SEQPACKET socket, the job's pipes passed with SCM_RIGHTS):
   -> {"job": id, "kind": "notebook"|"probe", "limit": s}  + fds (requests in, replies out)

@@ -22,8 +22,9 @@ memory of its processes and files together, an equal CPU share; else RLIMIT_NPRO
 root).
 Student code runs in jobs of a fork server started in the sandbox (servers.py, forkserver.py):
 one bubblewrap per server, a fresh child per notebook (its cells, then its checks' calls),
-everything of a job killed and removed when it ends; a server a job changed is replaced. `Sandbox.verify()` runs a probe as such a job and `report()`
-states only what the probe saw hold.
+everything of a job killed and removed when it ends; a server a job changed is replaced.
+`Sandbox.verify()` runs a probe as such a job and `report()` states only what the probe saw
+hold.
 """
 import dataclasses
 import json
