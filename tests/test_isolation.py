@@ -108,14 +108,22 @@ def _with_cell(source):
 
 
 @pytest.fixture(scope="module")
-def graded_as_user(tmp_path_factory):
+def graded_as_user():
     """A class graded by an ordinary user (nobody: no cgroups, RLIMIT_NPROC per user), two
     notebooks at a time: a fork to the process limit, a prlimit on the fork server, a forged
     first message, and an honest classmate."""
     import os
+    import tempfile
     if not SANDBOXED or os.geteuid() != 0 or not shutil.which("setpriv"):
         pytest.skip("needs root (to become an ordinary user) and bubblewrap")
-    base = tmp_path_factory.mktemp("as_user")
+    as_user = ["setpriv", f"--reuid={USER}", f"--regid={USER}", "--clear-groups",
+               "--inh-caps=-all"]
+    seen = subprocess.run(as_user + [sys.executable, "-S", "-c",
+                                     "import sys; print(sys.base_prefix)"],
+                          capture_output=True, text=True, timeout=60)
+    if seen.stdout.strip() != sys.base_prefix:  # e.g. a Python installed under /root
+        pytest.skip(f"an ordinary user cannot read this Python ({sys.base_prefix})")
+    base = Path(tempfile.mkdtemp(prefix="ikteach-as-user-"))  # pytest's folders are root's only
     subs = base / "submissions"
     shutil.copytree(ROOT / "instructor" / "solutions", subs / "honest")
     for name, source in (("fork_to_limit", FORK_TO_LIMIT), ("prlimit_server", PRLIMIT_SERVER),
@@ -125,16 +133,18 @@ def graded_as_user(tmp_path_factory):
     (base / "out").mkdir()
     for path in [base, *base.rglob("*")]:
         os.chown(path, USER, USER)
-    run = subprocess.run(["setpriv", f"--reuid={USER}", f"--regid={USER}", "--clear-groups",
-                          "--inh-caps=-all", sys.executable, "-m", "ikteach.course.grade",
-                          str(subs), "--out", str(base / "out" / "grades.csv"), "--timeout",
-                          str(TIMEOUT), "--grade-timeout", str(GRADE_TIMEOUT), "--jobs", "2",
-                          "--seed", "1"],
-                         capture_output=True, text=True, timeout=900, cwd=base,
-                         env={"PATH": os.environ["PATH"], "HOME": str(base), "LANG": "C.UTF-8"})
-    assert run.returncode == 0, run.stderr[-3000:]
-    rows = {r["student"]: r for r in csv.DictReader((base / "out" / "grades.csv").open())}
-    feedback = {p.stem: p.read_text() for p in (base / "out" / "feedback").glob("*.txt")}
+    try:
+        run = subprocess.run(
+            as_user + [sys.executable, "-m", "ikteach.course.grade", str(subs), "--out",
+                       str(base / "out" / "grades.csv"), "--timeout", str(TIMEOUT),
+                       "--grade-timeout", str(GRADE_TIMEOUT), "--jobs", "2", "--seed", "1"],
+            capture_output=True, text=True, timeout=900, cwd=base,
+            env={"PATH": os.environ["PATH"], "HOME": str(base), "LANG": "C.UTF-8"})
+        assert run.returncode == 0, run.stderr[-3000:]
+        rows = {r["student"]: r for r in csv.DictReader((base / "out" / "grades.csv").open())}
+        feedback = {p.stem: p.read_text() for p in (base / "out" / "feedback").glob("*.txt")}
+    finally:
+        shutil.rmtree(base, ignore_errors=True)
     return rows, feedback, run.stdout
 
 
