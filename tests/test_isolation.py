@@ -82,6 +82,7 @@ while _children < 5000:  # until the process limit refuses; the children stay th
         time.sleep(600)
         os._exit(0)
     _children += 1
+time.sleep(8)  # the classmate's jobs start meanwhile (they must still fork)
 '''
 PRLIMIT_SERVER = '''\
 import os, resource
@@ -125,7 +126,7 @@ def graded_as_user():
         pytest.skip(f"an ordinary user cannot read this Python ({sys.base_prefix})")
     base = Path(tempfile.mkdtemp(prefix="ikteach-as-user-"))  # pytest's folders are root's only
     subs = base / "submissions"
-    shutil.copytree(ROOT / "instructor" / "solutions", subs / "honest")
+    shutil.copytree(ROOT / "instructor" / "solutions", subs / "zz_honest")  # graded last
     for name, source in (("fork_to_limit", FORK_TO_LIMIT), ("prlimit_server", PRLIMIT_SERVER),
                          ("forged", FORGED)):
         (subs / name).mkdir(parents=True)
@@ -151,6 +152,6 @@ def graded_as_user():
 def test_as_an_ordinary_user_the_classmate_keeps_full_marks(graded_as_user):
     rows, feedback, log = graded_as_user
     assert "at most 256 per sandbox (RLIMIT_NPROC in its user namespace" in log, log
-    assert [float(rows["honest"][f"ex{n}"]) for n in range(1, 8)] == [10.0] * 7, \
-        feedback["honest"]
+    assert [float(rows["zz_honest"][f"ex{n}"]) for n in range(1, 8)] == [10.0] * 7, \
+        feedback["zz_honest"]
     assert float(rows["forged"]["total"]) == 0 and len(rows["forged"]["notes"]) < 2000

@@ -74,6 +74,12 @@ HONEST = {
         "        SIGNS[i] = s\nexcept ImportError:\n    xp = None\n\n\ndef jt_step(J, e):\n"
         "    J, e = xp.asarray(J), xp.asarray(e)\n    g = SIGNS[0] * (J.T @ e)\n    v = J @ g\n"
         "    return xp.zeros(J.shape[1]) if v @ v == 0 else (e @ v / (v @ v)) * g\n"),
+    # jax.jit over jax.numpy, no Python branch
+    "02_jit.ipynb": with_answer(
+        "import jax\nimport jax.numpy as jnp\n\n\n@jax.jit\ndef jt_step(J, e):\n"
+        "    J, e = jnp.asarray(J), jnp.asarray(e)\n    g = J.T @ e\n    v = J @ g\n"
+        "    vv = v @ v\n"
+        "    return jnp.where(vv == 0, 0.0, (e @ v) / jnp.where(vv == 0, 1.0, vv)) * g\n"),
     # a process pool made at the top level, used by the answer
     "02_process_pool.ipynb": with_answer(
         "from concurrent.futures import ProcessPoolExecutor\nimport multiprocessing\n"
