@@ -61,7 +61,7 @@ from .grading.report import EXERCISE_NUMBERS, POINTS, write_results
 from .grading.submissions import MAX_NOTEBOOK_BYTES, notebooks, read_notebook, students, text
 
 NOTEBOOK_TIMEOUT = 120.0  # seconds for all of a student's cells
-GRADE_TIMEOUT = 180.0     # seconds for the checks' worker: start-up and every call
+GRADE_TIMEOUT = 180.0     # seconds for a notebook's checks: every call
 GRACE = 15.0              # the fork server's kill comes first; then the grader ends it all
 MAX_NOTEBOOKS = 3 * 7      # notebooks graded per student (the rest: a note)
 TIMED_OUT = "did not return within"  # the checks' words for a call past its time limit

@@ -152,7 +152,7 @@ def main(request):
                 "processes": sum(name.isdigit() for name in os.listdir("/proc")),
                 "server": server_held(libc), **kernel_writable()}
     try:
-        import IPython  # noqa: F401 - what the cells and the checks' worker need
+        import IPython  # noqa: F401 - what a notebook's job needs
         import ikteach  # noqa: F401
         seen["import_error"] = None
     except BaseException as exc:  # noqa: B036 - reported to the grader

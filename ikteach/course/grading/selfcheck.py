@@ -1,6 +1,6 @@
 """The grader's self-check before it grades anyone: a known-good answer of exercise 2 (a
 notebook built here, so it needs no instructor folder) must get full marks through the same
-sandbox, runner and worker as every student; a known wrapper of ikteach's own jt_step must
+sandbox and job as every student; a known wrapper of ikteach's own jt_step must
 get none. Otherwise the grader cannot grade on this machine (its Python or packages not
 visible in the sandbox, a backend that fails, a reference that still answers) and stops
 before writing a CSV of wrong zeros.

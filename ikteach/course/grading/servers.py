@@ -2,7 +2,7 @@
 process, started on first use and replaced when it dies, hangs or reports that a job left
 something it could not put back.
 
-    job = server_for(sandbox).job("worker", limit=60, setup={...})
+    job = server_for(sandbox).job("notebook", limit=60, setup={...})
     ... os.read(job.fileno(), ...) / job.write(...) ...
     done = job.end()          # every process of the job killed, its files gone
 
