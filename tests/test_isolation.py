@@ -67,3 +67,91 @@ def test_shell_escapes_hold_to_the_time_limits(graded):
     took = re.search(r"shell_escapes/02_jt_step.ipynb: .* \((\d+) s\)", log)
     assert int(took.group(1)) <= TIMEOUT + GRADE_TIMEOUT + grade.GRACE, log
 
+
+
+# --- graded as an ordinary user (issue 41): no cgroups, the process limit counted per user ------
+FORK_TO_LIMIT = '''\
+import os, time
+_children = 0
+while _children < 5000:  # until the process limit refuses; the children stay through the checks
+    try:
+        pid = os.fork()
+    except OSError:
+        break
+    if pid == 0:
+        time.sleep(600)
+        os._exit(0)
+    _children += 1
+time.sleep(8)  # the classmate's jobs start meanwhile (they must still fork)
+'''
+PRLIMIT_SERVER = '''\
+import os, resource
+_server = os.getppid()  # the fork server that starts the next notebooks of this exercise
+resource.prlimit(_server, resource.RLIMIT_NOFILE, (24, 24))
+os.setpriority(os.PRIO_PROCESS, _server, 19)
+'''
+FORGED = '''\
+import json, os
+_forged = {"ready": ["x%d" % i for i in range(100000)],
+           "foreign": {"x%d" % i: "y" * 400 for i in range(20000)},
+           "held": {"%024d" % i: "z" * 80 for i in range(20000)}}
+os.write(4, (json.dumps(_forged) + "\\n").encode())  # the job's replies pipe
+'''
+USER = 65534  # nobody
+
+
+def _with_cell(source):
+    import json
+    book = json.loads((ROOT / "instructor" / "solutions" / "02_jt_step.ipynb").read_text())
+    book["cells"].insert(1, {"cell_type": "code", "metadata": {}, "outputs": [],
+                             "execution_count": None, "source": source})
+    return json.dumps(book)
+
+
+@pytest.fixture(scope="module")
+def graded_as_user():
+    """A class graded by an ordinary user (nobody: no cgroups, RLIMIT_NPROC per user), two
+    notebooks at a time: a fork to the process limit, a prlimit on the fork server, a forged
+    first message, and an honest classmate."""
+    import os
+    import tempfile
+    if not SANDBOXED or os.geteuid() != 0 or not shutil.which("setpriv"):
+        pytest.skip("needs root (to become an ordinary user) and bubblewrap")
+    as_user = ["setpriv", f"--reuid={USER}", f"--regid={USER}", "--clear-groups",
+               "--inh-caps=-all"]
+    seen = subprocess.run(as_user + [sys.executable, "-S", "-c",
+                                     "import sys; print(sys.base_prefix)"],
+                          capture_output=True, text=True, timeout=60)
+    if seen.stdout.strip() != sys.base_prefix:  # e.g. a Python installed under /root
+        pytest.skip(f"an ordinary user cannot read this Python ({sys.base_prefix})")
+    base = Path(tempfile.mkdtemp(prefix="ikteach-as-user-"))  # pytest's folders are root's only
+    subs = base / "submissions"
+    shutil.copytree(ROOT / "instructor" / "solutions", subs / "zz_honest")  # graded last
+    for name, source in (("fork_to_limit", FORK_TO_LIMIT), ("prlimit_server", PRLIMIT_SERVER),
+                         ("forged", FORGED)):
+        (subs / name).mkdir(parents=True)
+        (subs / name / "02_jt_step.ipynb").write_text(_with_cell(source))
+    (base / "out").mkdir()
+    for path in [base, *base.rglob("*")]:
+        os.chown(path, USER, USER)
+    try:
+        run = subprocess.run(
+            as_user + [sys.executable, "-m", "ikteach.course.grade", str(subs), "--out",
+                       str(base / "out" / "grades.csv"), "--timeout", str(TIMEOUT),
+                       "--grade-timeout", str(GRADE_TIMEOUT), "--jobs", "2", "--seed", "1"],
+            capture_output=True, text=True, timeout=900, cwd=base,
+            env={"PATH": os.environ["PATH"], "HOME": str(base), "LANG": "C.UTF-8"})
+        assert run.returncode == 0, run.stderr[-3000:]
+        rows = {r["student"]: r for r in csv.DictReader((base / "out" / "grades.csv").open())}
+        feedback = {p.stem: p.read_text() for p in (base / "out" / "feedback").glob("*.txt")}
+    finally:
+        shutil.rmtree(base, ignore_errors=True)
+    return rows, feedback, run.stdout
+
+
+def test_as_an_ordinary_user_the_classmate_keeps_full_marks(graded_as_user):
+    rows, feedback, log = graded_as_user
+    assert "at most 256 per sandbox (RLIMIT_NPROC in its user namespace" in log, log
+    assert [float(rows["zz_honest"][f"ex{n}"]) for n in range(1, 8)] == [10.0] * 7, \
+        feedback["zz_honest"]
+    assert float(rows["forged"]["total"]) == 0 and len(rows["forged"]["notes"]) < 2000

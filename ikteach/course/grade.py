@@ -7,46 +7,49 @@
     python -m ikteach.course.grade --gradescope OUT.zip      (a Gradescope autograder bundle)
 
 SUBMISSIONS_DIR holds one folder per student (the folder name is the student), each with that
-student's exercise notebooks (NN_name.ipynb, as handed out). For each notebook:
+student's exercise notebooks. A notebook is taken for an exercise by its metadata, else its
+content (the functions it defines, the check it calls), else an NN_ in its name (identify()).
+Each notebook is one job, in a sandbox (ikteach.course.grading.sandbox: bubblewrap, an
+unprivileged user without capabilities, no network, a read-only whitelist of the machine,
+resource limits; where no sandbox works the grader refuses unless --no-sandbox):
 
-1. its cells run in IPython's shell in a sandbox (ikteach.course.grading.sandbox: bubblewrap,
-   an unprivileged user without capabilities, no network, a read-only whitelist of the
-   machine, resource limits; where no sandbox works the grader refuses unless --no-sandbox),
-   for its errors and notes only - nothing it prints counts;
-2. the student's functions are taken from the notebook's source (top-level imports,
-   definitions and assignments, by the AST) into a second sandboxed process, and ik.check runs
-   in the grader's own process, calling them there through a pipe (each call under its time
-   limit), on hidden cases: the instant check's kinds with numbers drawn from a seed at
-   grading time (logged; --seed repeats a run). So nothing a notebook does to modules,
-   builtins, stdout or files changes a score. A graded name that is not a function written
-   in the notebook gets 0 (grading/own_code.py).
-Both processes see a copy of ikteach in which the exercise's reference answers are stubs that
-raise, without the checker and the self-check (grading/reference.py: what the grader
-guarantees and what it only reports - code copied from ikteach, in grades.csv's `copied`).
-They are fresh children of a fork server (grading/forkserver.py: one per sandbox, exercise and
-grading process, Python, JAX and ikteach imported once), which no student code ever ran in;
-after each, every process of the sandbox but the server is killed and what they wrote removed,
-so no notebook starts from a state another one touched.
+1. its code cells run in IPython's shell, as a kernel runs them (grading/cells.py); their
+   errors are notes, nothing they print counts;
+2. then ik.check runs in the grader's own process on hidden cases (the instant check's kinds
+   with numbers drawn from a seed at grading time, logged; --seed repeats a run), calling the
+   functions the cells left in the shell's namespace through a pipe, each call under its time
+   limit (grading/remote.py). So nothing a notebook does to modules, builtins, stdout or
+   files changes a score. A graded name that is not a function written in the notebook gets 0
+   (grading/own_code.py). A check that ran past its time limit is run again in a fresh job
+   before the timeout counts (a busy machine, a first compile).
+The job sees a copy of ikteach in which the exercise's reference answers are stubs that raise,
+without the checker and the self-check (grading/reference.py: what the grader guarantees and
+what it only reports - code copied from ikteach, in grades.csv's `copied`). It is a fresh child
+of a fork server (grading/forkserver.py: one per sandbox, exercise and grading process, Python,
+JAX and ikteach imported once), which no student code ever ran in; after each job every process
+of the sandbox but the server is killed and what they wrote removed, and a server the job
+changed (its files, limits or priorities) is replaced, so no notebook starts from a state
+another one touched.
 
 Before anyone is graded the sandbox is probed (the log states only what the probe saw hold)
 and a known-good answer must get full marks (grading/selfcheck.py); if either fails the grader
 stops with a non-zero exit status. The submissions folder is not trusted (grading/submissions.py):
 a symlink, FIFO, directory or malformed notebook costs only its student's marks, with a reason
-in the CSV's `notes`. Each notebook's cells get --timeout seconds and its checks
---grade-timeout, both enforced from outside the student's process (the fork server kills every
-process of the job; the grader kills the whole sandbox if the server does not answer).
+in the CSV's `notes`. Each notebook's cells get --timeout seconds (then the running cell is
+interrupted) and its checks --grade-timeout, both also enforced from outside the student's
+process (the fork server kills every process of the job; the grader kills the whole sandbox if
+the server does not answer).
 
 Writes one CSV row per student (ex1..ex7, total, sandbox, notes, copied) and a feedback file
 per student (FEEDBACK/<student>.txt, by default a `feedback` folder next to the CSV); the log
 starts with what the sandbox enforces and what it cannot on this machine.
 """
 import argparse
+import dataclasses
 import functools
-import json
 import os
 import re
 import secrets
-import select
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -58,67 +61,68 @@ from .grading.report import EXERCISE_NUMBERS, POINTS, write_results
 from .grading.submissions import MAX_NOTEBOOK_BYTES, notebooks, read_notebook, students, text
 
 NOTEBOOK_TIMEOUT = 120.0  # seconds for all of a student's cells
-GRADE_TIMEOUT = 180.0     # seconds for the checks' worker: start-up and every call
+GRADE_TIMEOUT = 180.0     # seconds for a notebook's checks: every call
 GRACE = 15.0              # the fork server's kill comes first; then the grader ends it all
+MAX_NOTEBOOKS = 3 * 7      # notebooks graded per student (the rest: a note)
+TIMED_OUT = "did not return within"  # the checks' words for a call past its time limit
 INSTRUCTOR = Path(__file__).resolve().parents[2] / "instructor"  # the solutions: hidden
 
 __all__ = ["grade_all", "grade_notebook", "grade_book", "exercise_number", "main",
            "MAX_NOTEBOOK_BYTES"]
 
 
-def exercise_number(path, book):
-    """The exercise a notebook answers: its metadata (ikteach.exercise), else NN_ in its name."""
+def _from_name(path):
+    """The exercise a file's name gives: its first NN_ that is an exercise's number (so Colab's
+    "Copy of 02_jt_step.ipynb" and a download's "02_jt_step (1).ipynb" are exercise 2)."""
+    for match in re.finditer(r"(?<!\d)(\d+)_", Path(path).name):
+        if int(match.group(1)) in EXERCISE_NUMBERS:
+            return int(match.group(1))
+    return None
+
+
+def _from_content(book):
+    """(exercise, why) from what the code cells define and check - every graded function of
+    exactly one exercise defined, or one exercise's check called; (None, None) otherwise.
+    Regular expressions on the text (linear: nothing here parses a student's code)."""
+    from . import check
+    from .grading.extract import code_cells
+
+    source = "\n".join(text_ for _, text_ in code_cells(book))
+    defined = set(re.findall(r"^def[ \t]+(\w+)[ \t]*\(", source, re.M))
+    checked = set(re.findall(r"^[ \t]*ik\.check\.(\w+)[ \t]*\(", source, re.M))
+    found = [n for n, m in check.EXERCISES.items() if set(m.FUNCTIONS) <= defined]
+    if len(found) > 1:  # several exercises' names defined: the one whose check is called
+        found = [n for n in found if check.EXERCISES[n].CHECK_NAME in checked] or found
+    if len(found) == 1:
+        names = ", ".join(f"`{f}`" for f in check.EXERCISES[found[0]].FUNCTIONS)
+        return found[0], f"by its content (it defines {names})"
+    called = [n for n, m in check.EXERCISES.items() if m.CHECK_NAME in checked]
+    if len(called) == 1:
+        return called[0], ("by its content (it calls "
+                           f"ik.check.{check.EXERCISES[called[0]].CHECK_NAME})")
+    return None, None
+
+
+def identify(path, book):
+    """(exercise number or None, how it was recognised): the notebook's metadata
+    (ikteach.exercise), else its content (the functions it defines, the check it calls), else
+    an NN_ in its file name."""
     meta = book.get("metadata") if isinstance(book, dict) else None
     meta = meta.get("ikteach") if isinstance(meta, dict) else None
     number = meta.get("exercise") if isinstance(meta, dict) else None
     if isinstance(number, int) and number in EXERCISE_NUMBERS:
-        return number
-    match = re.match(r"(\d+)_", Path(path).name)
-    if match and int(match.group(1)) in EXERCISE_NUMBERS:
-        return int(match.group(1))
-    return None
+        return number, "by its metadata"
+    if isinstance(book, dict):
+        number, why = _from_content(book)
+        if number is not None:
+            return number, why
+    number = _from_name(path)
+    return (number, "by its file name") if number is not None else (None, None)
 
 
-def _run_cells(book, sandbox, timeout, number):
-    """Run the notebook's cells in the sandbox that grades exercise `number`; (error lines,
-    notes) from the job's report."""
-    from .grading.extract import code_cells
-    from .grading.servers import server_for
-
-    job = server_for(sandbox, number).job("cells", timeout, {"cells": code_cells(book)})
-    report, ended = b"", None
-    try:
-        deadline = time.monotonic() + timeout + GRACE  # the server kills it at `timeout`
-        while len(report) < 1 << 20 and time.monotonic() < deadline:
-            if not select.select([job], [], [], deadline - time.monotonic())[0]:
-                break
-            chunk = os.read(job.fileno(), 1 << 16)
-            if not chunk:
-                break
-            report += chunk
-    finally:
-        ended = job.end(wait_for_exit=1.0)
-    errors, started, done = [], None, False
-    for line in report.decode(errors="replace").splitlines():
-        try:
-            message = json.loads(line)
-        except ValueError:
-            continue
-        if isinstance(message, dict):
-            errors += [str(message["error"])[:400]] if "error" in message else []
-            started = message.get("cell", started)
-            done = done or message.get("done") is True
-    if done:
-        return errors[:30], []
-    if started is None:
-        return errors[:30], [f"the notebook's run ended before its first cell (exit status "
-                             f"{ended.get('status')})"]
-    if ended.get("timed_out") or ended.get("status") is None:
-        return errors[:30], [f"cell {started} did not finish within the notebook's time limit "
-                             f"({timeout:g} s)"]
-    return errors[:30], [f"the notebook's run ended in cell {started} (exit status "
-                         f"{ended.get('status')}: a crash, os._exit, or a CPU, memory or "
-                         "file-size limit)"]
+def exercise_number(path, book):
+    """The exercise a notebook answers (identify()'s number)."""
+    return identify(path, book)[0]
 
 
 def _answer_text(book):
@@ -135,78 +139,82 @@ def _answer_text(book):
     return "\n".join(texts)[:4000]
 
 
-def _copied(number, book, held):
+def _copied(number, held):
     """Lines for the instructor: the notebook's functions whose code is exercise `number`'s
-    reference (compiled here from the source, and what the worker says it holds: a marshalled
-    or exec'd copy). Reported, never scored (grading/reference.py)."""
+    reference (`held`: the fingerprints of the code the notebook's namespace holds, computed
+    in its job, under its limits: nothing of a student's code is compiled here). Reported,
+    never scored (grading/reference.py)."""
     from . import check
     from .grading import reference
-    from .grading.extract import code_cells, without_magics
 
     known = reference.reference_fingerprints(check.EXERCISES[number].REFERENCES)
-    found = dict(held)
-    for cell, source in code_cells(book):
-        try:
-            found.update(reference.fingerprints([compile(without_magics(source), f"<cell {cell}>",
-                                                         "exec")]))
-        except (SyntaxError, ValueError, RecursionError, MemoryError):
-            continue  # not Python: the worker's notes say so
-    return reference.copied(found, known)
+    return reference.copied(held, known)
 
 
-def _check(number, book, sandbox, grade_timeout, seed=None):
-    """The verdict from ik.check in this process, on the student's functions in a worker
-    (`seed`: the hidden cases' seed), its notes, and what of its code is copied."""
+def _run(number, book, sandbox, timeout, grade_timeout, seed=None):
+    """(verdict or None, notes, copied): the notebook's cells and then ik.check's calls in one
+    job (grading/cells.py), the verdict computed in this process on the hidden cases drawn
+    from `seed`; notes: the cells' errors and what went wrong on the way."""
     from . import check
     from .grading.extract import code_cells
     from .grading.remote import ProcessEnded, Worker
 
     module = check.EXERCISES[number]
     worker = Worker(code_cells(book), sandbox, exercise=number, graded=module.FUNCTIONS,
-                    limit=grade_timeout)
+                    limit=grade_timeout, timeout=timeout)
     try:
         try:
             worker.start()
         except (ProcessEnded, ValueError) as exc:  # died, hung, or answered garbage
-            return None, [f"your code could not be loaded for the checks: {exc}"], []
-        copied = _copied(number, book, worker.held)
+            return None, worker.errors + (worker.notes or [f"nothing could be graded: {exc}"]), []
+        notes = worker.errors + worker.notes
+        copied = _copied(number, worker.held)
         if worker.foreign:  # a graded name bound to ikteach's (or anyone's) code: no marks
-            return (check.registry.refuse(number, " ".join(worker.foreign.values())),
-                    worker.notes, copied)
+            return (check.registry.refuse(number, " ".join(worker.foreign.values())), notes,
+                    copied)
         namespace = {name: worker.function(name) for name in worker.names}
-        return check.grade(number, namespace, seed=seed), worker.notes, copied
+        return check.grade(number, namespace, seed=seed), notes, copied
     finally:
         worker.end()
 
 
 def _result(name, number=None, message=""):
-    return {"file": text(name), "exercise": number, "score": 0.0, "max": float(POINTS),
+    return {"file": text(name), "exercise": number, "how": None, "score": 0.0, "max": float(POINTS),
             "status": "not graded", "message": message, "notes": [], "answer": "", "copied": []}
 
 
 def grade_book(name, book, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT,
-               sandbox=None, run_cells=True, seed=None):
+               sandbox=None, seed=None):
     """Grade one notebook (a dict) on the hidden cases drawn from `seed` (None: a fresh secret
-    one - never the instant check's public cases); returns a dict: file, exercise, score, max,
-    status, message, notes (what went wrong on the way), answer (the written answer, if any),
-    copied (functions whose code is ikteach's answer: for the instructor), seed."""
+    one - never the instant check's public cases); returns a dict: file, exercise, how (how the
+    exercise was recognised), score, max, status, message, notes (what went wrong on the way),
+    answer (the written answer, if any), copied (functions whose code is ikteach's answer: for
+    the instructor), seed. A check that ran past its time limit is run once more, in a fresh
+    job, before the timeout costs marks (the first run may have been slowed by a busy machine
+    or by compiling the check)."""
     from .grading.sandbox import Sandbox
 
     sandbox = sandbox or Sandbox()  # raises SandboxUnavailable where there is none
-    number = exercise_number(name, book)
+    number, how = identify(name, book)
     result = _result(name, number)
+    result["how"] = how
     result["seed"] = seed = secrets.randbits(63) if seed is None else int(seed)
     if number is None:
-        result["message"] = ("not an exercise notebook (no ikteach exercise number in its "
-                             "metadata or name)")
+        result["message"] = ("not an exercise notebook (no ikteach exercise in its metadata, "
+                             "its functions or its name)")
         return result
     started = time.monotonic()
     try:
         result["answer"] = _answer_text(book)
-        errors, notes = _run_cells(book, sandbox, timeout, number) if run_cells else ([], [])
-        verdict, check_notes, result["copied"] = _check(number, book, sandbox, grade_timeout,
-                                                        seed)
-        result["notes"] = errors + notes + check_notes
+        verdict, notes, result["copied"] = _run(number, book, sandbox, timeout, grade_timeout,
+                                                seed)
+        if verdict is not None and TIMED_OUT in verdict.message:  # confirmed before it counts
+            again, notes_again, _ = _run(number, book, sandbox, timeout, grade_timeout, seed)
+            if again is not None:
+                verdict, notes = again, notes_again + [
+                    "a check ran past its time limit and was run again in a fresh process: "
+                    "the marks are the second run's"]
+        result["notes"] = notes[:40]
         if verdict is None:
             result["message"] = "no grade: your code could not be loaded for the checks"
         else:
@@ -274,7 +282,8 @@ def grade_all(submissions, out, feedback=None, timeout=NOTEBOOK_TIMEOUT, jobs=1,
     out = Path(out)
     feedback = Path(feedback) if feedback else out.parent / "feedback"
     hidden = [submissions, out.parent, feedback, INSTRUCTOR, Path.cwd() / "instructor"]
-    sandbox = Sandbox(hidden, limits or Limits(), bwrap=bwrap, unsandboxed=unsandboxed)
+    limits = dataclasses.replace(limits or Limits(), jobs=max(1, int(jobs)))
+    sandbox = Sandbox(hidden, limits, bwrap=bwrap, unsandboxed=unsandboxed)
     try:
         if sandbox.unsandboxed:
             (warn or (lambda m: print(m, file=sys.stderr)))(
@@ -305,7 +314,10 @@ def grade_all(submissions, out, feedback=None, timeout=NOTEBOOK_TIMEOUT, jobs=1,
             except OSError as exc:
                 notes[name].append(f"the folder could not be read: {exc.strerror or exc}")
                 continue
-            jobs_list += [(name, path, why) for _, path, why in books]
+            for _, path, _why in books[MAX_NOTEBOOKS:]:
+                notes[name].append(f"{text(os.path.basename(path))}: not graded: more than "
+                                   f"{MAX_NOTEBOOKS} notebooks handed in")
+            jobs_list += [(name, path, why) for _, path, why in books[:MAX_NOTEBOOKS]]
         # by exercise: each exercise's fork server (its own copy of ikteach) starts once
         jobs_list.sort(key=lambda job: exercise_number(job[1], None) or 0)
         outcomes = _grade_jobs(jobs_list, jobs, timeout, grade_timeout, sandbox, seed)

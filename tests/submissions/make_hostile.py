@@ -226,7 +226,7 @@ _ANSWER = b"""def jt_step(J, e):
     return np.zeros(J.shape[1]) if vv == 0 else (e @ v / vv) * g
 """
 def _relay_put():
-    """In the notebook's run: the answer into a POSIX queue, SysV memory and a keyring."""
+    """In exercise 1's job: the answer into a POSIX queue, SysV memory and a keyring."""
     import platform
     queue = _libc.mq_open(_NAME, os.O_CREAT | os.O_WRONLY, 0o666, None)
     if queue >= 0:
@@ -238,7 +238,7 @@ def _relay_put():
     if add_key:
         _libc.syscall(add_key, b"user", b"ikteach-relay", _ANSWER, len(_ANSWER), -4)
 def _relay_get():
-    """In the checks' worker: whatever the notebook's run left, if anything."""
+    """In exercise 2's job: whatever exercise 1's left, if anything."""
     import platform
     buffer = ctypes.create_string_buffer(1 << 16)
     queue = _libc.mq_open(_NAME, os.O_RDONLY | os.O_NONBLOCK)
@@ -357,8 +357,11 @@ def main():
     write("remount_plant", "02_jt_step.ipynb", notebook(SOLUTION / "02_jt_step.ipynb", [REMOUNT_PLANT]))
     write("fill_tmpfs", "02_jt_step.ipynb", notebook(SOLUTION / "02_jt_step.ipynb", [FILL_TMPFS]))
     write("huge_array", "04_dls_step.ipynb", replace_function(SOLUTION / "04_dls_step.ipynb", HUGE_ARRAY))
-    relay = replace_cell(SOLUTION / "02_jt_step.ipynb", "jt_step", RELAY)
-    write("ipc_relay", "02_jt_step.ipynb", notebook_with(relay, ["_relay_put()"]))
+    # exercise 1's job (graded first) leaves the answer; exercise 2's looks for it
+    write("ipc_relay", "01_jacobian.ipynb", notebook(TEMPLATE / "01_jacobian.ipynb",
+                                                     [RELAY, "_relay_put()"]))
+    write("ipc_relay", "02_jt_step.ipynb", replace_cell(SOLUTION / "02_jt_step.ipynb", "jt_step",
+                                                        RELAY))
     for path in sorted(SOLUTION.glob("*.ipynb")):
         write("cell_magic", path.name, with_cell_magic(path, "%%time"))
     # graded in a class of their own (tests/test_isolation.py), beside an honest classmate

@@ -23,15 +23,24 @@ NAMESPACES = ["--unshare-user", "--uid", SANDBOX_ID, "--gid", SANDBOX_ID, "--cap
               "--unshare-net", "--unshare-pid", "--unshare-ipc", "--unshare-uts",
               "--unshare-cgroup-try", "--die-with-parent", "--new-session"]
 # (extra flags, sized tmpfs), tried in this order: an older bwrap has no --disable-userns or --size
+# the parts of /proc that write to the kernel of the whole machine, bound read-only (as Docker
+# and Flatpak do): a sandbox of a grader run as root is root's uid outside
+PROC_READ_ONLY = ("/proc/sys", "/proc/sysrq-trigger", "/proc/irq", "/proc/bus", "/proc/fs")
 VARIANTS = ((["--disable-userns"], True), ([], True), ([], False))
 TRIAL_TMPFS = 1 << 20
 # syscalls a student's process gets EPERM for: setsid (a new session is a new scheduler
-# autogroup: 200 of them would take the CPU from every other job) and the kernel keyrings
-# (not namespaced: a key would outlive its job); any other ABI (x32, 32-bit) is refused whole
+# autogroup: 200 of them would take the CPU from every other job), the kernel keyrings (not
+# namespaced: a key would outlive its job), file locks and file-change notification (a lock or
+# an inotify watch on a file every sandbox sees, such as the Python binary, is a channel between
+# jobs that run at once); any other ABI (x32, 32-bit) is refused whole
 SECCOMP = {"x86_64": (0xC000003E, {"setsid": 112, "add_key": 248, "request_key": 249,
-                                   "keyctl": 250}),
+                                   "keyctl": 250, "flock": 73, "inotify_init": 253,
+                                   "inotify_init1": 294, "fanotify_init": 300}, 72),
            "aarch64": (0xC00000B7, {"setsid": 157, "add_key": 217, "request_key": 218,
-                                    "keyctl": 219})}
+                                    "keyctl": 219, "flock": 32, "inotify_init1": 26,
+                                    "fanotify_init": 262}, 25)}
+# fcntl's commands refused: F_GETLK/F_SETLK/F_SETLKW, their OFD forms, leases and F_NOTIFY
+FCNTL_DENIED = (5, 6, 7, 36, 37, 38, 1024, 1025, 1026)
 
 
 class SandboxUnavailable(RuntimeError):
@@ -102,8 +111,10 @@ def command(bwrap, flags, package, hidden, work, pid1=False, tmpfs_bytes=None, s
 def private_mounts(tmpfs_bytes):
     """What a run may write besides its working folder, RAM-backed and each at most
     `tmpfs_bytes` (None: no size): /tmp and /dev/shm; /dev itself read-only; POSIX message
-    queues visible in /dev/mqueue (so that the fork server removes a job's with its files)."""
-    return (["--proc", "/proc", "--dev", "/dev", "--mqueue", "/dev/mqueue"]
+    queues visible in /dev/mqueue (so that the fork server removes a job's with its files); of
+    its own /proc, what writes to the machine's kernel read-only (PROC_READ_ONLY)."""
+    return (["--proc", "/proc"] + [a for p in PROC_READ_ONLY for a in ("--ro-bind-try", p, p)]
+            + ["--dev", "/dev", "--mqueue", "/dev/mqueue"]
             + sized_tmpfs("/dev/shm", tmpfs_bytes) + ["--remount-ro", "/dev"]
             + sized_tmpfs("/tmp", tmpfs_bytes))
 
@@ -117,15 +128,20 @@ def seccomp_program():
     import platform
     import struct
 
-    arch, calls = SECCOMP.get(platform.machine(), (None, {}))
+    arch, calls, fcntl = SECCOMP.get(platform.machine(), (None, {}, None))
     if arch is None:
         return None
-    deny = 5 + len(calls)  # the index of the EPERM return
-    code = [(0x20, 0, 0, 4), (0x15, 0, deny - 2, arch), (0x20, 0, 0, 0),
-            (0x35, deny - 4, 0, 0x40000000)]  # load arch; native? load nr; x32?
-    code += [(0x15, deny - 5 - i, 0, nr) for i, nr in enumerate(calls.values())]
+    # (code, jump if true, jump if false, k) with jumps as labels: "deny", "allow" or 0 (next)
+    code = [(0x20, 0, 0, 4), (0x15, 0, "deny", arch), (0x20, 0, 0, 0),  # arch; native? nr
+            (0x35, "deny", 0, 0x40000000)]                             # x32?
+    code += [(0x15, "deny", 0, nr) for nr in calls.values()]
+    code += [(0x15, 0, "allow", fcntl), (0x20, 0, 0, 24)]  # fcntl? load its command (low word)
+    code += [(0x15, "deny", 0, cmd) for cmd in FCNTL_DENIED]
     code += [(0x06, 0, 0, 0x7FFF0000), (0x06, 0, 0, 0x00050000 | 1)]  # ALLOW, ERRNO(EPERM)
-    return b"".join(struct.pack("HBBI", *op) for op in code)
+    where = {"allow": len(code) - 2, "deny": len(code) - 1}
+    jump = lambda to, at: where[to] - at - 1 if isinstance(to, str) else to  # noqa: E731
+    return b"".join(struct.pack("HBBI", op, jump(jt, i), jump(jf, i), k)
+                    for i, (op, jt, jf, k) in enumerate(code))
 
 
 def seccomp_fd():
@@ -185,6 +201,8 @@ def judge(seen, escaped, hidden):
         failures.append("it could reach the grader's machine over the network")
     if seen.get("mounted"):
         failures.append("it could mount a file system")
+    if seen.get("kernel_settings"):
+        failures.append(f"it could open {', '.join(seen['kernel_settings'])} for writing")
     server = seen.get("server")
     if not isinstance(server, dict) or any(server.values()) or not server:
         failures.append(f"it could reach the fork server that starts every notebook ({server})")
@@ -204,6 +222,9 @@ def judge(seen, escaped, hidden):
                      "and what they wrote removed")
     lines.append("cannot ptrace, read the memory of, or stop the fork server that starts every "
                  "notebook in a fresh child")
+    if seen.get("oom_lowered") is False:
+        lines.append("cannot write /proc or /sys: the kernel's settings (/proc/sys "
+                     "read-only, tried core_pattern) nor its own OOM priority (Landlock)")
     if seen.get("userns_blocked"):
         lines.append("cannot create user namespaces (so it cannot regain capabilities)")
     if seen.get("new_session") is False:

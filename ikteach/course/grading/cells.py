@@ -1,18 +1,29 @@
-"""Run a student's notebook cells for their errors and notes (never for marks), in a child of
-the fork server (forkserver.py), with IPython's shell as a kernel would.
+"""A notebook's job, in a fresh child of the fork server (forkserver.py): its code cells run in
+IPython's shell, in order, as a kernel runs them; then the checks call the functions those cells
+left in the shell's namespace - the namespace the notebook built (top-level classes, constants
+made in loops, module aliases, `from __future__` imports), not a re-reading of its source.
 
-The grader sends one JSON line on REQUESTS: {"cells": [[cell number, source], ...]}. Every code
-cell runs in order, except cells that only call ik.check (the grader runs the checks itself,
-elsewhere). Before each cell a line {"cell": N} goes to REPLIES, after a cell that raised
-{"error": "cell N raised Name: value"}, and {"done": true} at the end. The time limit is the
-fork server's: it kills the whole job; the grader then knows from the last {"cell": N} which
-cell did not finish.
+The grader sends one JSON line on REQUESTS: {"cells": [[number, source], ...], "graded": [names],
+"timeout": s}. Cells that only call ik.check are skipped (the grader runs the checks itself).
+Before each cell a line {"cell": N} goes to REPLIES, after a cell that raised {"error": "cell N
+raised Name: value"}. The cells get `timeout` seconds in all: then the running cell is
+interrupted (SIGALRM) and the rest skipped ({"stopped": N}); a notebook that ignores the alarm
+is killed from outside by the fork server and the grader. Then {"ready": ...} (remote.serve)
+and the calls. Code objects compile as `<cell N>` (tracebacks and grading/own_code.py name them);
+a cell starting with %%time or %%capture runs as its body (their own compile names it otherwise).
 """
 import json
 import os
 import re
+import signal
+
+from .extract import cell_body
 
 MAX_TEXT = 300  # characters of an error message kept
+
+
+class NotebookTime(BaseException):
+    """Raised in the running cell when the notebook's time is up."""
 
 
 def only_checks(source):
@@ -27,31 +38,68 @@ def error_line(number, exc):
             f"{': ' + value[0][:MAX_TEXT] if value and value[0] else ''}")
 
 
-def run(cells, send):
+def shell():
+    """IPython's shell, without history (no database, no thread); cells compile as <cell N>."""
     from IPython.core.interactiveshell import InteractiveShell
     from traitlets.config import Config
 
     config = Config()
-    config.HistoryManager.enabled = False  # no database, no thread
-    shell = InteractiveShell.instance(config=config)
-    for number, source in cells:
-        if only_checks(source):
-            continue
-        send({"cell": number})
-        result = shell.run_cell(source, store_history=False)
-        exc = result.error_before_exec or result.error_in_exec
-        if exc is not None:
-            send({"error": error_line(number, exc)})
-    send({"done": True})
+    config.HistoryManager.enabled = False
+    instance = InteractiveShell.instance(config=config)
+    instance.compile.get_code_name = lambda raw, transformed, number: f"<cell {number}>"
+    return instance
+
+
+def _time_up(signum, frame):
+    raise NotebookTime()
+
+
+def run(instance, cells, send, timeout):
+    """Run the cells; True when all ran, else the number of the cell the time limit stopped."""
+    signal.signal(signal.SIGALRM, _time_up)
+    signal.setitimer(signal.ITIMER_REAL, timeout)
+    try:
+        for number, source in cells:
+            if only_checks(source):
+                continue
+            send({"cell": number})
+            instance.execution_count = number  # the <cell N> name (get_code_name's number)
+            result = instance.run_cell(cell_body(source), store_history=False)
+            exc = result.error_before_exec or result.error_in_exec
+            if isinstance(exc, NotebookTime):
+                send({"stopped": number})
+                return number
+            if exc is not None:
+                send({"error": error_line(number, exc)})
+    except NotebookTime:  # between cells, or in IPython's own code
+        send({"stopped": "the end"})
+        return False
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, signal.SIG_DFL)
+    return True
+
+
+def namespace(instance):
+    """What the cells defined: the shell's namespace without IPython's own names."""
+    hidden = instance.user_ns_hidden
+    return {k: v for k, v in instance.user_ns.items()
+            if k not in hidden and not re.fullmatch(r"_+|_[iho]+\d*|_dh|_ii+", k)}
 
 
 def main(requests_fd, replies_fd):
-    with os.fdopen(requests_fd, "r", encoding="utf-8", errors="replace") as requests:
-        setup = json.loads(requests.readline())
+    from . import remote
+
+    requests = os.fdopen(requests_fd, "r", encoding="utf-8", errors="replace")
     replies = os.fdopen(replies_fd, "w")
 
     def send(message):
         replies.write(json.dumps(message) + "\n")
         replies.flush()
 
-    run([(int(n), str(s)) for n, s in setup["cells"]], send)
+    setup = json.loads(requests.readline())
+    instance = shell()
+    run(instance, [(int(n), str(s)) for n, s in setup["cells"]], send,
+        float(setup.get("timeout", 120.0)))
+    remote.serve(namespace(instance), [str(n) for n in setup.get("graded", [])], requests,
+                 send)

@@ -1,9 +1,12 @@
 """The fork server: one per sandbox and grading process, it pays Python's, JAX's and ikteach's
-start-up once and forks a fresh child for every job (a notebook's cells, its checks' worker,
-the start-up probe). Runs inside the sandbox (bubblewrap --as-pid-1: it is the PID namespace's
-init), started by servers.py:
+start-up once and forks a fresh child for every job (a notebook's cells and then its checks'
+calls, cells.py; the start-up probe). Runs inside the sandbox (bubblewrap --as-pid-1: it is
+the PID namespace's init), started by servers.py:
 
-    python -m ikteach.course.grading.forkserver CONTROL_FD SANDBOXED(0|1)
+    python -m ikteach.course.grading.forkserver CONTROL_FD SANDBOXED(0|1) NPROC
+
+NPROC (0: leave it): the processes its sandbox may have (RLIMIT_NPROC, set by the server on
+itself before any job: sandbox.py's quota()).
 
 Each child starts from the server's state, which no student code ever ran in: the server only
 imports modules and never starts JAX's backend (so it has one thread, and a fork copies it
@@ -12,12 +15,17 @@ job pipes; everything else the server holds is closed in it. When the child ends
 grader says so, or its time limit passes) the server, as PID 1, kills every other process of
 the namespace (kill(-1): daemons, setsid, fork storms), reaps them, removes the job's folder,
 whatever appeared in the sandbox's writable /tmp and /dev, and SysV IPC objects; if anything
-there that existed before was changed (a /dev node replaced, /tmp's mode), it says `dirty` and
-the grader starts a fresh server. The server is not dumpable (no ptrace, no /proc/1/mem) and,
-as init, ignores every signal from inside the namespace that it has no handler for.
+there that existed before was changed (a /dev node replaced, /tmp's mode), or its own limits,
+priority, CPU set or OOM score are not those it started with (a job may `prlimit` its server:
+same uid), it says `dirty` and the grader starts a fresh server: every job starts with the
+limits the grader set from outside. In the sandbox a job's child may write only beneath its
+folder, /tmp, /dev/shm and /dev's devices (Landlock, where the kernel has it: no /proc or /sys
+file, e.g. its own oom_score_adj or the kernel's settings, opens for writing). The server is
+not dumpable (no ptrace, no /proc/1/mem) and, as init, ignores every signal from inside the
+namespace that it has no handler for.
 
 Control messages (JSON over a SOCK_SEQPACKET socket, the job's pipes passed with SCM_RIGHTS):
-  -> {"job": id, "kind": "cells"|"worker"|"probe", "limit": s}  + fds (requests in, replies out)
+  -> {"job": id, "kind": "notebook"|"probe", "limit": s}  + fds (requests in, replies out)
   -> {"end": id}                                            the grader is done with the job
   <- {"done": id, "status": exit status or null, "timed_out": bool, "dirty": bool}
 """
@@ -34,9 +42,12 @@ import stat
 import sys
 import time
 
+from ikteach.course.grading import landlock
+
 PR_SET_DUMPABLE, PR_SET_CHILD_SUBREAPER = 4, 36
 IPC_RMID = 0
 SHARED = ("/tmp", "/dev")  # what the sandbox user can write besides the job folder (probed)
+WRITABLE = ("/tmp", "/dev/shm")  # where a job may write besides its folder (Landlock)
 
 
 def preload():
@@ -47,7 +58,7 @@ def preload():
 
     import ikteach  # noqa: F401
     import ikteach.core.solve  # noqa: F401
-    from ikteach.course.grading import cells, extract, own_code, probe, remote  # noqa: F401
+    from ikteach.course.grading import cells, own_code, probe, remote  # noqa: F401
 
 
 def _libc():
@@ -79,6 +90,24 @@ def _state(roots, keep):
     return seen
 
 
+def own_state(libc):
+    """What a job could change of this process from outside it (same uid): its limits, nice
+    value, CPU set, scheduler and OOM score."""
+    import resource
+
+    limits = {name: resource.getrlimit(getattr(resource, name)) for name in dir(resource)
+              if name.startswith("RLIMIT_")}
+    try:
+        with open("/proc/self/oom_score_adj") as handle:
+            oom = handle.read().strip()
+    except OSError:
+        oom = None
+    affinity = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else None
+    scheduler = os.sched_getscheduler(0) if hasattr(os, "sched_getscheduler") else None
+    return {"limits": limits, "nice": os.getpriority(os.PRIO_PROCESS, 0), "oom": oom,
+            "affinity": affinity, "scheduler": scheduler}
+
+
 def _remove(path):
     try:
         if stat.S_ISDIR(os.lstat(path).st_mode):
@@ -101,14 +130,18 @@ def _remove_ipc(libc):
 
 
 class Server:
-    def __init__(self, control, sandboxed):
-        self.control, self.sandboxed = control, sandboxed
+    def __init__(self, control, sandboxed, nproc=0):
+        self.control, self.sandboxed, self.nproc = control, sandboxed, nproc
         self.libc = _libc()
         self.home = os.getcwd()  # the server's own folder (bound read-write)
         self.pid1 = os.getpid() == 1
-        self.baseline = None
+        self.baseline, self.state = None, None
 
     def start(self):
+        import resource
+
+        if self.nproc:  # this sandbox's user namespace: its own count of processes
+            resource.setrlimit(resource.RLIMIT_NPROC, (self.nproc, self.nproc))
         _prctl(self.libc, PR_SET_DUMPABLE, 0)
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         if not self.pid1:  # unsandboxed: orphans of a job come back here, to be ended
@@ -117,6 +150,7 @@ class Server:
             if not self.pid1:
                 raise RuntimeError("the fork server must be PID 1 of its sandbox")
             self.baseline = _state(SHARED, self.home)
+        self.state = own_state(self.libc)
 
     def send(self, message):
         self.control.send(json.dumps(message).encode())
@@ -138,7 +172,7 @@ class Server:
         os.makedirs(os.path.join(job, "home", "tmp"))
         pid = os.fork()
         if pid == 0:
-            _child(request["kind"], fds, job, self.control.fileno())
+            _child(request["kind"], fds, job, self.control.fileno(), self.sandboxed)
         for fd in fds:
             os.close(fd)
         status, timed_out = self.wait(pid, request)
@@ -196,11 +230,11 @@ class Server:
     def clean(self):
         """Remove what the job left: its folder (all of the server's folder but the folder
         itself) and, in the sandbox, whatever is new in the shared places and SysV IPC objects.
-        True when something is left or was changed that cannot be put back (the server must
-        then be replaced)."""
+        True when something is left or was changed that cannot be put back, this process's own
+        limits and priorities included (the server must then be replaced)."""
         for name in os.listdir(self.home):
             _remove(os.path.join(self.home, name))
-        left = bool(os.listdir(self.home))
+        left = bool(os.listdir(self.home)) or own_state(self.libc) != self.state
         if not self.sandboxed:
             return left
         _remove_ipc(self.libc)
@@ -224,7 +258,7 @@ def _children():
     return found
 
 
-def _child(kind, fds, job, control):
+def _child(kind, fds, job, control, sandboxed):
     """The job's process: fresh session and folder, only its pipes; never returns."""
     code = 1
     try:
@@ -246,12 +280,11 @@ def _child(kind, fds, job, control):
         os.close(null)
         os.chdir(job)
         os.environ.update(HOME=os.path.join(job, "home"), TMPDIR=os.path.join(job, "home", "tmp"))
-        if kind == "cells":
+        if sandboxed:
+            landlock.restrict([job] + list(WRITABLE))
+        if kind == "notebook":
             from ikteach.course.grading import cells
             cells.main(requests, replies)
-        elif kind == "worker":
-            from ikteach.course.grading import remote
-            remote.worker(requests, replies)
         elif kind == "probe":
             from ikteach.course.grading import probe
             probe.job(requests, replies)
@@ -267,7 +300,7 @@ def main(argv):
         os.dup2(null, fd)
     try:
         preload()
-        server = Server(control, argv[1] == "1")
+        server = Server(control, argv[1] == "1", int(argv[2]) if len(argv) > 2 else 0)
         server.start()
         hello = {"ready": True, "threads": len(os.listdir("/proc/self/task")),
                  "pid": os.getpid(), "import_error": None}

@@ -85,6 +85,31 @@ def new_session():
     return os.waitpid(pid, 0)[1] == 0
 
 
+def kernel_writable():
+    """What of the machine's kernel settings and its own OOM priority the job could change:
+    /proc/sys files that open for writing (opened, never written) and whether its
+    oom_score_adj goes down (then put back)."""
+    opened = []
+    for path in ("/proc/sys/kernel/core_pattern", "/proc/sys/vm/panic_on_oom",
+                 "/proc/sysrq-trigger"):
+        try:
+            os.close(os.open(path, os.O_WRONLY))
+            opened.append(path)
+        except OSError:
+            pass
+    try:
+        with open("/proc/self/oom_score_adj") as handle:
+            before = handle.read().strip()
+        with open("/proc/self/oom_score_adj", "w") as handle:
+            handle.write("0")
+        lowered = True
+        with open("/proc/self/oom_score_adj", "w") as handle:
+            handle.write(before)
+    except OSError:
+        lowered = False
+    return {"kernel_settings": opened, "oom_lowered": lowered}
+
+
 def job(requests_fd, replies_fd):
     """The probe as a job of the fork server (forkserver.py): the request on one pipe, what it
     saw on the other."""
@@ -125,9 +150,9 @@ def main(request):
                 "read": readable(request["reads"]), "connected": connected(request["port"]),
                 "mounted": mounted(libc, package), "userns_blocked": userns_blocked(libc), "new_session": new_session(),
                 "processes": sum(name.isdigit() for name in os.listdir("/proc")),
-                "server": server_held(libc)}
+                "server": server_held(libc), **kernel_writable()}
     try:
-        import IPython  # noqa: F401 - what the cells and the checks' worker need
+        import IPython  # noqa: F401 - what a notebook's job needs
         import ikteach  # noqa: F401
         seen["import_error"] = None
     except BaseException as exc:  # noqa: B036 - reported to the grader

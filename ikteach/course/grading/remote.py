@@ -1,30 +1,29 @@
-"""The student's functions in a separate, sandboxed worker process; the checks call them
-through proxies and compute the marks in the grader's own process.
+"""The student's functions stay in the notebook's job (cells.py: the cells ran there, in IPython's
+shell); the checks call them through proxies and compute the marks in the grader's own process.
 
-The worker (worker(), in a fresh child of the fork server) executes only the kept top-level statements
-(imports, definitions, assignments - see extract.py) of the student's code cells, then answers
-calls: one JSON line per request and per reply on its own pipes (its stdout and stdin are
-/dev/null to the student's code). Values cross as JSON (numbers, strings, lists, dicts, arrays
-as nested lists); a function the student returns (a step function) stays in the worker and
-crosses as a handle; a function of ikteach that the checks pass crosses by its name. Whatever
-the worker sends can only be a value of the student's own function: the verdict is computed
-here, by the checks of this process's ikteach.
+After the cells the job answers calls: one JSON line per request and per reply on its own pipes
+(its stdout and stdin are /dev/null to the student's code). Values cross as JSON (numbers,
+strings, lists, dicts, arrays as nested lists); a function the student returns (a step function)
+stays in the job and crosses as a handle; a function of ikteach that the checks pass crosses by
+its name. Whatever the job sends can only be a value of the student's own function: the verdict
+is computed here, by the checks of this process's ikteach. Everything a job says is bounded
+here (MAX_REPLY, MAX_NOTES, MAX_NAMES, MAX_HELD), however many notebooks a student hands in.
 """
-import ast
 import functools
 import importlib
 import json
-import linecache
 import os
 import select
 import signal
 import time
 import traceback
 
-STATEMENT_LIMIT = 20.0   # seconds for one top-level statement of the student's code
-STARTUP_LIMIT = 120.0    # seconds for the worker to import ikteach and run those statements
+STARTUP_LIMIT = 120.0    # seconds for the job to start (the fork server's fork: milliseconds)
 CALL_LIMIT = 600.0       # last-resort limit on one reply (the checks' own limit is shorter)
 MAX_REPLY = 64 << 20     # bytes
+MAX_NOTES, MAX_NAMES, MAX_HELD = 30, 200, 200
+GRACE = 15.0             # seconds past the cells' own alarm before the job is killed
+HELD_LIMIT = 5.0         # seconds for the fingerprints of the code a notebook holds
 
 
 class ProcessEnded(Exception):
@@ -121,7 +120,7 @@ def _handle_doc(*args):
     """A function your code returned (it runs in your code's process)."""
 
 
-# --- the worker -----------------------------------------------------------------------------------
+# --- the job's side -------------------------------------------------------------------------------
 
 def _student_line(exc):
     for frame in reversed(traceback.extract_tb(exc.__traceback__)):
@@ -131,55 +130,30 @@ def _student_line(exc):
     return ""
 
 
-def _alarm(signum, frame):
-    raise TimeoutError("took too long")
+class _TimeUp(BaseException):
+    pass
 
 
-def _define(cells):
-    """Execute the kept statements of each cell; the namespace and notes on what failed."""
-    from ikteach.course.grading.extract import kept_statements
-
-    namespace, notes = {"__name__": "__main__", "__builtins__": __builtins__}, []
-    signal.signal(signal.SIGALRM, _alarm)
-    for number, source in cells:
-        filename = f"<cell {number}>"
-        linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)
-        try:
-            nodes = kept_statements(source)
-        except (SyntaxError, ValueError) as exc:
-            notes.append(f"cell {number} is not valid Python ({type(exc).__name__}: "
-                         f"{getattr(exc, 'msg', exc)}); its definitions were not graded")
-            continue
-        for node in nodes:
-            try:
-                signal.setitimer(signal.ITIMER_REAL, STATEMENT_LIMIT)
-                exec(compile(ast.Module([node], []), filename, "exec"), namespace)
-            except BaseException as exc:  # noqa: B036 - the student's error, reported
-                notes.append(f"cell {number}, line {node.lineno}: {type(exc).__name__}: "
-                             f"{str(exc).splitlines()[0][:200] if str(exc) else ''}")
-            finally:
-                signal.setitimer(signal.ITIMER_REAL, 0)
-    return namespace, notes
+def _time_up(signum, frame):
+    raise _TimeUp()
 
 
-def worker(requests_fd, replies_fd):
-    """The worker's loop, in a child of the fork server (forkserver.py), on its job's pipes
-    (its stdin and stdout are /dev/null: the student's prints and input() see nothing)."""
-    requests = os.fdopen(requests_fd, "r", encoding="utf-8", errors="replace")
-    replies = os.fdopen(replies_fd, "w")
+def serve(namespace, graded, requests, send):
+    """After the cells (cells.py): say what the namespace holds, then answer calls, one JSON
+    line each, until the grader closes the requests."""
     from ikteach.core.solve import StopSolve
     from ikteach.course.grading import own_code, reference
 
-    def send(message):
-        replies.write(json.dumps(message) + "\n")
-        replies.flush()
-
-    setup = json.loads(requests.readline())
-    namespace, notes = _define(setup["cells"])
-    held = reference.fingerprints(reference.held_code(namespace))  # reported, not trusted
+    signal.signal(signal.SIGALRM, _time_up)
+    signal.setitimer(signal.ITIMER_REAL, HELD_LIMIT)
+    try:  # reported, not trusted; under its own limit (a cell crafted to make it slow)
+        held = reference.fingerprints(reference.held_code(namespace))
+    except _TimeUp:
+        held = {}
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
     send({"ready": sorted(k for k, v in namespace.items() if callable(v) and k[:2] != "__"),
-          "notes": notes, "foreign": own_code.foreign(namespace, setup.get("graded", [])),
-          "held": held})
+          "foreign": own_code.foreign(namespace, graded), "held": held})
     handles = []
     for line in requests:
         request = json.loads(line)
@@ -203,50 +177,81 @@ def worker(requests_fd, replies_fd):
 # --- the grader's side ------------------------------------------------------------------------------
 
 class Worker:
-    """One worker for one notebook's code: a fresh child of the sandbox's fork server for
-    `exercise` (servers.py: its copy of ikteach has no answer to it), started by start().
-    graded: the names the check grades; `limit`: seconds for the whole worker (start-up and
-    every call), applied from outside the student's process: it is then killed, whatever it
-    does with its signals. After start(): names, notes, foreign (graded names not written in
-    the notebook), held ({fingerprint: function name} of the code its namespace holds)."""
+    """One notebook's job: a fresh child of the sandbox's fork server for `exercise`
+    (servers.py: its copy of ikteach has no answer to it), started by start(): its `cells` run
+    (at most `timeout` s in all), then it serves the checks' calls. graded: the names the check
+    grades; `limit`: seconds for the checks (every call), applied from outside the student's
+    process: it is then killed, whatever it does with its signals. After start(): errors
+    (cells that raised), notes (what went wrong on the way), names, foreign (graded names not
+    written in the notebook), held ({fingerprint: function name} of the code it holds)."""
 
-    def __init__(self, cells, sandbox, exercise=None, graded=(),
-                 limit=STARTUP_LIMIT + CALL_LIMIT):
+    def __init__(self, cells, sandbox, exercise=None, graded=(), limit=CALL_LIMIT,
+                 timeout=STARTUP_LIMIT):
         self.cells, self.sandbox, self.exercise = cells, sandbox, exercise
-        self.setup = {"cells": cells, "graded": list(graded)}
-        self.limit, self.deadline = limit, None
-        self.process, self.names, self.notes, self.foreign, self.held = None, [], [], {}, {}
+        self.graded = list(graded)
+        self.setup = {"cells": cells, "graded": self.graded, "timeout": float(timeout)}
+        self.limit, self.timeout, self.deadline = limit, timeout, None
+        self.process, self.names, self.errors, self.notes = None, [], [], []
+        self.foreign, self.held, self._buffer = {}, {}, b""
 
     def start(self):
+        """Run the cells; raises ProcessEnded when the job did not get to its checks (the notes
+        then say which cell it was in)."""
         from .servers import server_for
 
-        self.deadline = time.monotonic() + self.limit
-        self.process = server_for(self.sandbox, self.exercise).job("worker", self.limit + 5,
-                                                                   self.setup)
+        # after the job's own alarm: killed from outside (`grace` also for its start-up)
+        grace = min(GRACE, self.timeout) + GRACE
+        self.deadline = time.monotonic() + self.timeout + grace
+        self.process = server_for(self.sandbox, self.exercise).job(
+            "notebook", self.timeout + grace + self.limit, self.setup)
+        cell = None
         try:
-            ready = self._read(STARTUP_LIMIT + STATEMENT_LIMIT * len(self.cells))
+            while True:
+                try:
+                    message = self._read(self.deadline - time.monotonic(), during="cells")
+                except ProcessEnded as exc:
+                    where = "before its first cell" if cell is None else f"in cell {cell}"
+                    self.notes.append(f"the notebook's run ended {where}: {exc}")
+                    raise
+                if not isinstance(message, dict):
+                    continue
+                if "ready" in message:
+                    break
+                if "error" in message and len(self.errors) < MAX_NOTES:
+                    self.errors.append(str(message["error"])[:400])
+                if "stopped" in message:
+                    self.notes.append(f"cell {str(message['stopped'])[:20]} did not finish "
+                                      "within the notebook's time limit "
+                                      f"({self.timeout:g} s): it was stopped there")
+                cell = str(message["cell"])[:20] if "cell" in message else cell
         except BaseException:
             self.end()
             raise
-        self.names = [str(n) for n in ready.get("ready", [])]
-        self.notes = [str(n)[:300] for n in ready.get("notes", [])][:20]
-        foreign = ready.get("foreign", {})
-        self.foreign = {str(k): str(v)[:400] for k, v in foreign.items()} \
-            if isinstance(foreign, dict) else {}
-        held = ready.get("held", {})
-        self.held = {str(k)[:64]: str(v)[:80] for k, v in list(held.items())[:2000]} \
+        self.deadline = time.monotonic() + self.limit
+        self.names = [str(n)[:200] for n in message.get("ready", [])][:MAX_NAMES]
+        foreign = message.get("foreign", {})
+        self.foreign = {k: str(v)[:400] for k, v in foreign.items()
+                        if k in self.graded} if isinstance(foreign, dict) else {}
+        held = message.get("held", {})
+        self.held = {str(k)[:64]: str(v)[:80] for k, v in list(held.items())[:MAX_HELD]} \
             if isinstance(held, dict) else {}
         return self
 
     def _write(self, message):
         self.process.write((json.dumps(message) + "\n").encode())
 
-    def _read(self, timeout):
-        fd, chunks, size = self.process.fileno(), [], 0
-        while True:
+    def _read(self, timeout, during="checks"):
+        """The job's next message (one JSON line), waiting at most `timeout` s and never past
+        the deadline (of the cells or of the checks: `during`)."""
+        fd = self.process.fileno()
+        while b"\n" not in self._buffer:
             left = self.deadline - time.monotonic()
             ready, _, _ = select.select([fd], [], [], max(0.0, min(timeout, left)))
             if not ready:
+                if left <= timeout and during == "cells":
+                    raise ProcessEnded("it did not finish within the notebook's time limit "
+                                       f"({self.timeout:g} s) and ignored the alarm: it was "
+                                       "killed, and nothing could be graded")
                 if left <= timeout:
                     raise ProcessEnded(f"your code ran past the grading time limit of "
                                        f"{self.limit:g} s: it was stopped")
@@ -256,12 +261,11 @@ class Worker:
                 code = self.process.end(wait_for_exit=5)["status"]
                 raise ProcessEnded(f"the process running your code ended (exit status {code}:"
                                    " os._exit, a crash, or a CPU/memory limit)")
-            chunks.append(chunk)
-            size += len(chunk)
-            if size > MAX_REPLY:
+            self._buffer += chunk
+            if len(self._buffer) > MAX_REPLY:
                 raise ProcessEnded("your function's result is too large to check")
-            if chunk.endswith(b"\n"):
-                return json.loads(b"".join(chunks))
+        line, _, self._buffer = self._buffer.partition(b"\n")
+        return json.loads(line)
 
     def call(self, target, args):
         """target: a name (str) or a handle (int); returns the value or raises as the student's
@@ -278,9 +282,12 @@ class Worker:
         except BaseException:  # a time limit, or a broken worker: end it, it may be busy
             self.end()
             raise
+        if not isinstance(reply, dict):
+            self.end()
+            raise ProcessEnded("the process running your code answered garbage")
         if "value" in reply:
             return decode(reply["value"], call=self.call)
-        raised = reply.get("raise", {})
+        raised = reply.get("raise") if isinstance(reply.get("raise"), dict) else {}
         if raised.get("kind") == "stop":
             raise StopSolve(raised.get("message", ""))
         if raised.get("kind") == "not yet":

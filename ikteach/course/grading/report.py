@@ -3,9 +3,12 @@ why a notebook was not graded, copied: graded code that is ikteach's own answer,
 instructor to judge) and one feedback file per student. Every text is printable UTF-8
 (grading/submissions.text), whatever the file names and notebooks held; no CSV cell starts a
 spreadsheet formula; each student's name is NFC-normalised, or written with escapes where two
-names differ only in normalisation; a feedback file name is short whatever the name's length."""
+names differ only in normalisation, and with a hash of the folder's bytes where two still look
+alike (labels()): every folder its own row and feedback file; a feedback file name is short
+whatever the name's length."""
 import csv
 import hashlib
+import os
 import unicodedata
 
 from ..check.registry import NUMBERS as EXERCISE_NUMBERS
@@ -23,12 +26,18 @@ def cell(value):
 
 
 def labels(students):
-    """{folder name: the name its row shows}: NFC, unless another folder has the same NFC (then
-    the raw name with every non-ASCII character escaped, so that the rows differ visibly)."""
+    """{folder name: the name its row shows}, different for any two folders: NFC, unless
+    another folder has the same NFC (then the raw name with every non-ASCII character escaped,
+    so that the rows differ visibly); names that still look alike (a folder literally named
+    `M\\xfcller` beside one whose name is the Latin-1 bytes) or differ only in case (one
+    feedback file on macOS or Windows) get a short hash of the folder's own bytes."""
     shown = {s: unicodedata.normalize("NFC", text(s)) for s in students}
     clashes = {n for n in shown.values() if list(shown.values()).count(n) > 1}
-    return {s: (text(s).encode("ascii", "backslashreplace").decode() if n in clashes else n)
-            for s, n in shown.items()}
+    shown = {s: (text(s).encode("ascii", "backslashreplace").decode() if n in clashes else n)
+             for s, n in shown.items()}
+    folded = [n.casefold() for n in shown.values()]
+    return {s: (f"{n} [{hashlib.sha256(os.fsencode(s)).hexdigest()[:8]}]"
+                if folded.count(n.casefold()) > 1 else n) for s, n in shown.items()}
 
 
 def file_name(label):
@@ -50,7 +59,9 @@ def _feedback_text(student, results):
         if r is None:
             lines.append(f"Exercise {number}: 0/{POINTS} - no notebook submitted")
             continue
-        lines.append(f"Exercise {number} ({r['file']}): {r['score']:g}/{r['max']:g}")
+        how = (f", taken as exercise {number} {r['how']}"
+               if r.get("how") not in (None, "by its metadata") else "")
+        lines.append(f"Exercise {number} ({r['file']}{how}): {r['score']:g}/{r['max']:g}")
         for line in r["message"].splitlines():
             lines.append(f"  {line}")
         for note in r["notes"]:

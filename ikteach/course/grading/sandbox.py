@@ -5,11 +5,14 @@ Backend: bubblewrap (`bwrap`; Debian/Ubuntu/Fedora/Arch package `bubblewrap`), s
 run sees a read-only whitelist of the machine (system libraries, a few files of /etc, the
 Python the grader runs on, ikteach's package without its checker) and its own working folder;
 /tmp private; no network; own PID, IPC and UTS namespaces; its own user namespace as an
-unprivileged uid with no capabilities, also when the grader runs as root.
+unprivileged uid with no capabilities, also when the grader runs as root; /proc/sys and the other
+parts of /proc that write to the machine's kernel read-only, and (Landlock, forkserver.py) no
+file outside its folders, /tmp and /dev/shm opens for writing: not its own oom_score_adj.
 What a run writes lives in memory, size-limited (tmpfs: /tmp, /dev/shm, its working folder;
 /dev read-only); POSIX message queues show in /dev/mqueue, so the fork server removes a job's;
-seccomp refuses new sessions (one scheduler autogroup per sandbox, not one per busy child) and
-the kernel keyrings (not namespaced).
+seccomp refuses new sessions (one scheduler autogroup per sandbox, not one per busy child), the
+kernel keyrings (not namespaced), file locks and inotify (a lock or a watch on a file every
+sandbox sees is a channel between jobs that run at once).
 Always: own HOME, bare environment (BLAS kernel variables passed through, so that the student's
 numbers come from the same kernels as the grader's), resource limits (CPU time, address space,
 file size, no core files), its own process group (ended as a whole, from outside), the OOM
@@ -18,9 +21,10 @@ process may make cgroups (v1 pids/memory/cpu, or v2), one per sandbox: processes
 memory of its processes and files together, an equal CPU share; else RLIMIT_NPROC (not for
 root).
 Student code runs in jobs of a fork server started in the sandbox (servers.py, forkserver.py):
-one bubblewrap per server, a fresh child per notebook run or checks' worker, everything of a job
-killed and removed when it ends. `Sandbox.verify()` runs a probe as such a job and `report()`
-states only what the probe saw hold.
+one bubblewrap per server, a fresh child per notebook (its cells, then its checks' calls),
+everything of a job killed and removed when it ends; a server a job changed is replaced.
+`Sandbox.verify()` runs a probe as such a job and `report()` states only what the probe saw
+hold.
 """
 import dataclasses
 import json
@@ -62,6 +66,7 @@ class Limits:
     cpu_seconds: int = 600
     memory_mb: int = 4096
     processes: int = 256
+    jobs: int = 1  # sandboxes at once (the grader's --jobs): each gets its own process quota
     file_mb: int = 256
     tmpfs_mb: int = 256  # each of a sandbox's /tmp, /dev/shm and working folder
 
@@ -214,7 +219,10 @@ class Sandbox:
         if "pids" in has:
             yes.append(f"processes: at most {lim.processes} (cgroup pids.max)")
         elif not self.root:
-            yes.append(f"processes: at most {lim.processes} for this user (RLIMIT_NPROC)")
+            yes.append(f"processes: at most {lim.processes} per sandbox (RLIMIT_NPROC in its "
+                       "user namespace; the user's limit leaves room for every sandbox's)"
+                       if self.bwrap else
+                       f"processes: at most {lim.processes} for this user (RLIMIT_NPROC)")
         else:
             no.append("process count (root ignores RLIMIT_NPROC and the pids cgroup is not "
                       "writable): a fork storm is bounded only by the CPU and time limits")
@@ -229,6 +237,9 @@ class Sandbox:
             yes.append("visible, read-only, by its mount list (probed only as above): the "
                        "system libraries, the grader's Python, ikteach's package without its "
                        "checker; nothing else of this machine")
+            if not any(line.startswith("cannot write /proc") for line in self.verified):
+                no.append("a job's own OOM priority and /proc files it owns (no Landlock in "
+                          "this kernel): it can lower its oom_score_adj")
             no.append("a kernel exploit (bubblewrap shares this machine's kernel)")
         else:
             no += [f"ISOLATION: NONE ({OVERRIDE}): students' code runs with this user's rights",
@@ -267,12 +278,34 @@ class Sandbox:
         return sandbox_copy(self.package, folder / "ikteach", EXERCISES[exercise].REFERENCES,
                             exercise, base=self.package_for(None))
 
+    def quota(self):
+        """Processes of one sandbox, where it is bounded by RLIMIT_NPROC (an ordinary user
+        without a pids cgroup; 0: not so bounded)."""
+        return self.limits.processes if not self.root and "pids" not in self.controlled else 0
+
+    def outer_nproc(self):
+        """RLIMIT_NPROC from outside: this user's processes now plus every sandbox's quota.
+        Linux (5.14+) counts a user namespace's processes apart and also against the limit its
+        creator had: each sandbox's fork server lowers its own to quota(), so one sandbox's fork
+        storm stops at its quota, never at the user's, and a classmate's sandbox can still fork."""
+        if not self.quota():
+            return 0
+        uid, mine = os.getuid(), 0
+        for name in os.listdir("/proc"):
+            try:
+                mine += name.isdigit() and os.stat(f"/proc/{name}").st_uid == uid
+            except OSError:
+                continue
+        if not self.bwrap:
+            return self.limits.processes
+        return mine + self.limits.jobs * (self.quota() + 16) + 64
+
     def command(self, argv, work, cgroups, pid1=False, seccomp=None, package=None):
         """The full command line: launcher (limits), then bwrap (if any), then argv (`pid1`:
         as the init of its PID namespace; `seccomp`: the fd of bwrap's filter; `package`: the
         copy of ikteach it sees)."""
         lim = self.limits
-        nproc = lim.processes if (not self.root and "pids" not in self.controlled) else 0
+        nproc = self.outer_nproc()
         launch = [sys.executable, "-S", str(LAUNCH), str(lim.cpu_seconds),
                   str(lim.memory_mb << 20), str(lim.file_mb << 20), str(nproc),
                   ",".join(map(str, cgroups)) or "-", "--"]

@@ -2,7 +2,7 @@
 process, started on first use and replaced when it dies, hangs or reports that a job left
 something it could not put back.
 
-    job = server_for(sandbox).job("worker", limit=60, setup={...})
+    job = server_for(sandbox).job("notebook", limit=60, setup={...})
     ... os.read(job.fileno(), ...) / job.write(...) ...
     done = job.end()          # every process of the job killed, its files gone
 
@@ -63,7 +63,8 @@ class Server:
         try:
             self.process = sandbox.start(
                 [sys.executable, "-m", "ikteach.course.grading.forkserver", str(theirs.fileno()),
-                 "1" if sandbox.bwrap else "0"], self.dir, pid1=True, exercise=exercise,
+                 "1" if sandbox.bwrap else "0", str(sandbox.quota() if sandbox.bwrap else 0)],
+                self.dir, pid1=True, exercise=exercise,
                 pass_fds=(theirs.fileno(),),
                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         finally:

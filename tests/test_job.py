@@ -1,0 +1,215 @@
+"""A notebook's job (issue 41): its cells run in IPython's shell and the checks call what they
+built, in one fresh process; what a job can reach of the machine, its fork server and the next
+job; how a notebook is taken for its exercise; names a lecturer can tell apart.
+
+With bubblewrap (as root here and in CI) the job is in the sandbox; without it the grader's
+--no-sandbox path runs the same job, and the tests of what only a sandbox stops are skipped
+(tests/test_grade.py checks the refusal there).
+"""
+import copy
+import json
+import multiprocessing
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from ikteach.course import grade
+from ikteach.course.grading import report, servers
+from ikteach.course.grading.remote import Worker
+from ikteach.course.grading.sandbox import Sandbox
+from sandboxes import SANDBOXED
+
+ROOT = Path(__file__).resolve().parents[1]
+SOLUTION = json.loads((ROOT / "instructor" / "solutions" / "02_jt_step.ipynb").read_text())
+JT = """\
+    J, e = np.asarray(J), np.asarray(e)
+    g = J.T @ e
+    v = J @ g
+    return np.zeros(J.shape[1]) if v @ v == 0 else (e @ v / (v @ v)) * g
+"""
+
+
+@pytest.fixture(scope="module")
+def sandbox():
+    box = Sandbox([]) if SANDBOXED else Sandbox([], unsandboxed=True)
+    yield box
+    servers.close_all()
+    box.close()
+
+
+def without_metadata(book):
+    book = copy.deepcopy(book)
+    book["metadata"] = {"kernelspec": {"name": "python3"}, "colab": {"provenance": []}}
+    return book
+
+
+def with_answer(source):
+    """Exercise 2's solution notebook with its answer cell replaced by `source`."""
+    book = copy.deepcopy(SOLUTION)
+    cell = next(c for c in book["cells"] if c["cell_type"] == "code"
+                and "def jt_step(" in "".join(c["source"]))
+    cell["source"] = source
+    return book
+
+
+HONEST = {
+    # Colab's copy: "Copy of ...", the course metadata gone
+    "Copy of 02_jt_step.ipynb": without_metadata(SOLUTION),
+    # renamed, no metadata: taken by its content
+    "my homework.ipynb": without_metadata(SOLUTION),
+    # a top-level class used by the answer, under postponed annotations
+    "02_future_class.ipynb": with_answer(
+        "from __future__ import annotations\nimport dataclasses\n\n\n@dataclasses.dataclass\n"
+        "class Step:\n    alpha: float\n    g: np.ndarray\n\n    def delta(self) -> np.ndarray:\n"
+        "        return self.alpha * self.g\n\n\ndef jt_step(J, e) -> np.ndarray:\n"
+        "    J, e = np.asarray(J), np.asarray(e)\n    g = J.T @ e\n    v = J @ g\n"
+        "    alpha = 0.0 if v @ v == 0 else e @ v / (v @ v)\n"
+        "    return Step(alpha, g).delta()\n"),
+    # a constant table built in a loop inside a try, and a module alias set the same way
+    "02_loop_constants.ipynb": with_answer(
+        "SIGNS = {}\ntry:\n    import numpy as xp\n    for i, s in enumerate([1.0, -1.0]):\n"
+        "        SIGNS[i] = s\nexcept ImportError:\n    xp = None\n\n\ndef jt_step(J, e):\n"
+        "    J, e = xp.asarray(J), xp.asarray(e)\n    g = SIGNS[0] * (J.T @ e)\n    v = J @ g\n"
+        "    return xp.zeros(J.shape[1]) if v @ v == 0 else (e @ v / (v @ v)) * g\n"),
+    # jax.jit over jax.numpy, no Python branch
+    "02_jit.ipynb": with_answer(
+        "import jax\nimport jax.numpy as jnp\n\n\n@jax.jit\ndef jt_step(J, e):\n"
+        "    J, e = jnp.asarray(J), jnp.asarray(e)\n    g = J.T @ e\n    v = J @ g\n"
+        "    vv = v @ v\n"
+        "    return jnp.where(vv == 0, 0.0, (e @ v) / jnp.where(vv == 0, 1.0, vv)) * g\n"),
+    # a process pool made at the top level, used by the answer
+    "02_process_pool.ipynb": with_answer(
+        "from concurrent.futures import ProcessPoolExecutor\nimport multiprocessing\n"
+        "POOL = ProcessPoolExecutor(2, mp_context=multiprocessing.get_context('fork'))\n\n\n"
+        "def jt_step(J, e):\n    J, e = np.asarray(J), np.asarray(e)\n"
+        "    g = POOL.submit(np.dot, J.T, e).result()\n    v = J @ g\n"
+        "    return np.zeros(J.shape[1]) if v @ v == 0 else (e @ v / (v @ v)) * g\n"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(HONEST))
+def test_every_honest_way_of_writing_the_answer_gets_its_marks(sandbox, name):
+    result = grade.grade_book(name, HONEST[name], 60, 120, sandbox, seed=1)
+    assert result["exercise"] == 2 and result["score"] == 10, result
+    assert not [n for n in result["notes"] if "raised" in n], result["notes"]
+    if name.startswith("my"):
+        assert result["how"] == "by its content (it defines `jt_step`)", result["how"]
+
+
+def test_a_notebook_is_taken_for_its_exercise_by_metadata_content_or_name():
+    assert grade.identify("Copy of 05_stop_rule.ipynb", {"cells": []}) == (5, "by its file name")
+    assert grade.identify("2024_hw_03_pinv_step (1).ipynb", {"cells": []})[0] == 3
+    assert grade.identify("x.ipynb", without_metadata(SOLUTION))[0] == 2
+    assert grade.identify("01_jacobian.ipynb", SOLUTION) == (2, "by its metadata")
+    assert grade.identify("notes.ipynb", {"cells": [{"cell_type": "code",
+                                                     "source": "print(1)"}]}) == (None, None)
+
+
+SEEN = """\
+import fcntl, os, sys
+def seen():
+    out = {}
+    for path in ["/proc/sys/kernel/core_pattern", "/proc/sys/vm/panic_on_oom",
+                 "/proc/sysrq-trigger", "/proc/self/oom_score_adj", "/proc/1/oom_score_adj"]:
+        try:
+            os.close(os.open(path, os.O_WRONLY))  # opened, never written
+            out[path] = "opened for writing"
+        except OSError as exc:
+            out[path] = exc.strerror
+    with open(sys.executable, "rb") as shared:  # a file every sandbox sees
+        for name, lock in [("lockf", lambda: fcntl.lockf(shared, fcntl.LOCK_SH | fcntl.LOCK_NB)),
+                           ("flock", lambda: fcntl.flock(shared, fcntl.LOCK_SH | fcntl.LOCK_NB))]:
+            try:
+                lock()
+                out[name] = "locked"
+            except OSError as exc:
+                out[name] = exc.strerror
+    return out
+"""
+
+
+@pytest.mark.skipif(not SANDBOXED, reason="only the sandbox stops it (the refusal is tested)")
+def test_nothing_of_the_kernel_is_writable_and_no_lock_is_shared(sandbox):
+    """As root with bubblewrap (this machine, CI): /proc/sys and the job's own oom_score_adj do
+    not open for writing, and a lock on a file all sandboxes see is refused."""
+    worker = Worker([(1, SEEN)], sandbox, exercise=2).start()
+    try:
+        seen = worker.call("seen", [])
+    finally:
+        worker.end()
+    assert all(v != "opened for writing" for v in seen.values()), seen
+    assert seen["lockf"] != "locked" and seen["flock"] != "locked", seen
+    assert os.geteuid() != 0 or seen["/proc/sys/kernel/core_pattern"] in (
+        "Read-only file system", "Permission denied"), seen
+
+
+ATTACK_SERVER = """\
+import os, resource
+_server = os.getppid()  # the fork server that starts every notebook of this exercise
+resource.prlimit(_server, resource.RLIMIT_NOFILE, (24, 24))
+os.setpriority(os.PRIO_PROCESS, _server, 19)
+"""
+
+
+def test_a_job_that_changes_its_fork_server_does_not_reach_the_next(sandbox):
+    """prlimit and setpriority on the server (same uid): the next notebook gets a fresh one."""
+    first = servers.server_for(sandbox, 2)
+    attacked = copy.deepcopy(SOLUTION)
+    attacked["cells"].insert(1, {"cell_type": "code", "metadata": {}, "outputs": [],
+                                 "execution_count": None, "source": ATTACK_SERVER})
+    grade.grade_book("attack.ipynb", attacked, 60, 120, sandbox, seed=1)
+    assert servers.server_for(sandbox, 2) is not first
+    after = grade.grade_book("b.ipynb", SOLUTION, 60, 120, sandbox, seed=1)
+    assert after["score"] == 10 and after["notes"] == [], after
+
+
+FORGED = """\
+import json, os
+_forged = {"ready": ["x%d" % i for i in range(100000)],
+           "foreign": {"x%d" % i: "y" * 400 for i in range(20000)},
+           "held": {"%024d" % i: "z" * 80 for i in range(20000)}}
+os.write(4, (json.dumps(_forged) + "\\n").encode())  # the job's replies pipe
+"""
+
+
+def test_what_a_job_says_is_bounded(sandbox):
+    """A notebook that forges the job's first message: what the grader keeps of it is
+    bounded (not the 20000 entries), and the forged list of names gives it nothing."""
+    book = with_answer(FORGED)
+    result = grade.grade_book("forged.ipynb", book, 60, 120, sandbox, seed=1)
+    assert result["score"] == 0 and len(json.dumps(result)) < 40_000, len(json.dumps(result))
+
+
+def _hog(n):
+    return [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(n)]
+
+
+def test_marks_do_not_depend_on_the_machine_s_load(sandbox):
+    """Exercise 5's solution (its check compiles ik.solve and runs it under a 30 s limit) and
+    exercise 2's, graded quiet and beside two busy processes per core: the same marks."""
+    books = {n: json.loads((ROOT / "instructor" / "solutions" / n).read_text())
+             for n in ("02_jt_step.ipynb", "05_stop_rule.ipynb")}
+    quiet = {n: grade.grade_book(n, b, 60, 180, sandbox, seed=3)["score"]
+             for n, b in books.items()}
+    hogs = _hog(2 * multiprocessing.cpu_count())
+    try:
+        busy = {n: grade.grade_book(n, b, 60, 180, sandbox, seed=3)["score"]
+                for n, b in books.items()}
+    finally:
+        for hog in hogs:
+            hog.kill()
+            hog.wait()
+    assert quiet == busy == {n: 10.0 for n in books}, (quiet, busy)
+
+
+def test_any_two_folders_get_two_rows_and_two_feedback_files():
+    latin1 = os.fsdecode(b"M\xfcller")
+    names = [latin1, "M\\xfcller", "Müller", "Mu\u0308ller", "Anna", "anna", "x" * 255]
+    shown = report.labels(names)
+    assert len(set(shown.values())) == len(names), shown
+    files = {report.file_name(label).casefold() for label in shown.values()}
+    assert len(files) == len(names), files
+    assert shown["x" * 255] == "x" * 255 and shown[latin1].startswith("M\\xfcller [")
