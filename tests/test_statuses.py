@@ -14,6 +14,7 @@ import ikteach as ik
 from ikteach.core import stop_rules
 from ikteach.core._validate import round_finite
 from ikteach.core.levels import rest_gain_bound
+from ikteach.core.problem import Problem
 from ikteach.core.tasks import task_for
 
 UR5_GOAL = np.array([0.3, -1.0, 1.2, 0.4, 0.8, -0.5])
@@ -149,9 +150,10 @@ def test_fabrik_on_a_hinge_chain_stops_at_its_own_fixed_point():
     not a minimum of ||e||; a Jacobian method goes on from there."""
     res = ik.solve(FABRIK_ARM, FABRIK_TARGET, np.zeros(3), method="fabrik")
     assert res.status != "damped" and res.error > 1.0
-    task = task_for(FABRIK_ARM, (3,))
-    kinds = stop_rules.why_stalled(task, FABRIK_ARM, FABRIK_TARGET[None], res.theta[None],
-                                   np.array([True]), ik.Options(tol=NO_LIMITS.tol).resolved(1.0, 3), own_update=True)
+    problem = Problem(task_for(FABRIK_ARM, (3,)), FABRIK_ARM, jnp.asarray(FABRIK_TARGET))
+    kinds = stop_rules.why_stalled(problem, FABRIK_TARGET[None], res.theta[None], np.array([True]),
+                                   ik.Options(tol=NO_LIMITS.tol).resolved(1.0, 3), ((0, 1, 2),),
+                                   own_update=True)
     assert stop_rules.KIND_STATUS[int(kinds[0])] == "fixed_point"
     assert ik.solve(FABRIK_ARM, FABRIK_TARGET, res.theta, method="pinv").converged
 
