@@ -25,14 +25,16 @@ solve has one level, e itself.
 
   probe       up to PROBE_STEPS light priority steps (ik.core.priority.multilevel_step; DLS for
               one level) from where the solve stopped, each capped at PROBE_MAX_TURN radians (it
-              stays in the basin it starts in) and kept only when it helps: some level's ||e_k||
-              falls while no level before it rises more than IMPROVABLE ||e|| above its start.
+              stays near the basin it starts in) and kept only when it helps: some level's
+              ||e_k|| falls while no level before it rises by more than a visible change above
+              its start (visible: more than tol and more than IMPROVABLE ||e||; a priority
+              step's lower level may disturb a level before it by that much, and the next
+              step's correction brings it back).
               lambda starts at PROBE_DAMPING sigma_max (sigma_max: J's largest singular value,
-              so the probe is scale-free), is divided by PROBE_ADAPT after a kept step and
-              multiplied by it after a refused one (Levenberg-Marquardt).
+              so the probe is scale-free), is divided by PROBE_LIGHTER after a kept step and
+              multiplied by PROBE_HEAVIER after a refused one (Levenberg-Marquardt).
   gain        the probe gains when it converges (||e|| < tol), or when some level's ||e_k||
-              fell by more than tol and more than IMPROVABLE ||e|| with no level before it
-              risen by more than IMPROVABLE ||e||.
+              fell by a visible change with no level before it risen by one.
 
   MINIMUM      "stalled": no gain and the Hessian H of 1/2 ||e_0||^2 (level 0) has no clearly
                negative eigenvalue: a minimum of ||e||, the target out of reach of this start
@@ -68,8 +70,8 @@ SLOW_PROGRESS = 1e-4  # "slow" when ||e|| still fell by more than this fraction 
 CURVATURE_FRACTION = 1e-6  # a saddle: an eigenvalue of H below -this fraction of sigma_max^2
 PROBE_STEPS = 30  # the probe: at most this many light steps
 PROBE_DAMPING = 1e-2  # the probe's first lambda, as a fraction of sigma_max
-PROBE_ADAPT = 4.0  # lambda / PROBE_ADAPT after a kept step, x PROBE_ADAPT after a refused one
-PROBE_MAX_TURN = 0.1  # radians per probe step: the probe stays in the basin it starts in
+PROBE_LIGHTER, PROBE_HEAVIER = 3.0, 2.0  # lambda / 3 after a kept step, x 2 after a refused one
+PROBE_MAX_TURN = 0.1  # radians per probe step: the probe stays near the basin it starts in
 IMPROVABLE = 1e-3  # a gain counts above this fraction of ||e|| (and above tol)
 MINIMUM, SADDLE, CUT_SHORT, FIXED_POINT = range(4)  # what stall_kind returns
 KIND_STATUS = ("stalled", "singular", "damped", "fixed_point")  # the status each kind reports
@@ -114,18 +116,18 @@ def level_norms(e, levels):
 
 def helps(start, current, trial, slack):
     """Is `trial` better than `current`, level by level? Some level falls while no level
-    before it rises more than `slack` above where the probe started (`start`)."""
+    before it is more than `slack` above where the probe started (`start`)."""
     held = trial <= start + slack
     held_before = jnp.cumprod(jnp.concatenate([jnp.ones(1, bool), held[:-1]]))
     return jnp.any((trial < current) & (held_before > 0))
 
 
-def gains(start, end, scale, tol):
-    """Did the probe gain? Some level fell by more than tol and IMPROVABLE scale, and no level
-    before it rose by more than IMPROVABLE scale."""
+def gains(start, end, visible):
+    """Did the probe gain? Some level fell by more than `visible` while no level before it
+    rose by more than `visible`."""
     fall = start - end
-    held_before = jnp.cumprod(jnp.concatenate([jnp.ones(1), (fall > -IMPROVABLE * scale)[:-1]]))
-    return jnp.any((fall > jnp.maximum(IMPROVABLE * scale, tol)) & (held_before > 0))
+    held_before = jnp.cumprod(jnp.concatenate([jnp.ones(1), (fall >= -visible)[:-1]]))
+    return jnp.any((fall > visible) & (held_before > 0))
 
 
 def probe(problem, theta, levels, free, lower, upper, sigma_max, slack):
@@ -144,7 +146,7 @@ def probe(problem, theta, levels, free, lower, upper, sigma_max, slack):
         trial_norms = level_norms(problem.error(trial), levels)
         kept = helps(start, norms, trial_norms, slack)
         return (jnp.where(kept, trial, q), jnp.where(kept, trial_norms, norms),
-                jnp.where(kept, f / PROBE_ADAPT, f * PROBE_ADAPT))
+                jnp.where(kept, f / PROBE_LIGHTER, f * PROBE_HEAVIER))
 
     end, norms, _ = jax.lax.fori_loop(0, PROBE_STEPS, one, (theta, start, PROBE_DAMPING))
     return end, norms
@@ -167,10 +169,9 @@ def stall_kind(problem, theta, lower, upper, levels, tol):
     g = J.T @ e
     free = ~(((theta <= lower) & (g < 0)) | ((theta >= upper) & (g > 0)))  # not pushed into a limit
     sigma_max = jnp.linalg.norm(J * free, 2)
-    scale = jnp.linalg.norm(e)
-    end, norms = probe(problem, theta, levels, free, lower, upper, sigma_max, IMPROVABLE * scale)
-    gained = gains(level_norms(e, levels), norms, scale, tol) | \
-        (jnp.linalg.norm(problem.error(end)) < tol)
+    visible = jnp.maximum(IMPROVABLE * jnp.linalg.norm(e), tol)  # smaller changes do not count
+    end, norms = probe(problem, theta, levels, free, lower, upper, sigma_max, visible)
+    gained = gains(level_norms(e, levels), norms, visible) | (jnp.linalg.norm(problem.error(end)) < tol)
     at_saddle = saddle(problem, theta, levels[0], free, sigma_max)
     return jnp.where(gained, CUT_SHORT, jnp.where(at_saddle, SADDLE, MINIMUM))
 
