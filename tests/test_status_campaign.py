@@ -1,4 +1,4 @@
-"""Every status checked against its own definition on a seeded campaign (issue 40): 360 solves,
+"""Every status checked against its own definition on a seeded campaign (issue 40): 432 solves,
 planar arms with links of very different lengths at scales 1e-3..1e3, every method, damping,
 caps and clamps, reachable and unreachable targets, and UR5 poses with priority levels.
 
@@ -66,9 +66,9 @@ def level_norms(E, rows):
     return np.stack([np.linalg.norm(E[:, r], axis=1) for r in rows], axis=1)
 
 
-def judged(task, arm, targets, thetas, rows, tol, margin=1.0):
-    """For each row: does the judge gain margin times the definition's gain (above), and is
-    level 0's Hessian clearly negative somewhere (a saddle)?"""
+def judged(task, arm, targets, thetas, rows, tol):
+    """For each row: does the judge gain (the definition above), does it gain twice that, and
+    is level 0's Hessian clearly negative somewhere (a saddle)?"""
     ends = np.asarray(judge_run(task, arm, rows)(jnp.asarray(targets), jnp.asarray(thetas), tol))
     errors = jax.jit(jax.vmap(lambda t, q: task.error(arm, t, q)))
     E0, E1 = np.asarray(errors(targets, thetas)), np.asarray(errors(targets, ends))
@@ -77,8 +77,9 @@ def judged(task, arm, targets, thetas, rows, tol, margin=1.0):
     fall = before - after
     visible = np.maximum(GAIN * scale, tol)
     held = np.cumprod(np.concatenate([np.ones((len(fall), 1)), fall[:, :-1] >= -visible], 1), 1)
-    gain = np.any((fall > margin * visible) & (held > 0), axis=1)
-    gain |= np.linalg.norm(E1, axis=1) < tol
+    gain, double = (np.any((fall > m * visible) & (held > 0), axis=1) for m in (1, 2))
+    reached = np.linalg.norm(E1, axis=1) < tol  # reached: a gain under either margin
+    gain, double = gain | reached, double | reached
 
     def lowest_curvature(t, q):
         half = lambda p: 0.5 * jnp.sum(task.error(arm, t, p)[jnp.asarray(rows[0])] ** 2)
@@ -86,7 +87,7 @@ def judged(task, arm, targets, thetas, rows, tol, margin=1.0):
         return jnp.linalg.eigvalsh(jax.hessian(half)(q))[0] / sigma**2
 
     curvature = np.asarray(jax.jit(jax.vmap(lowest_curvature))(targets, thetas))
-    return gain, curvature < -1e-6
+    return gain, double, curvature < -1e-6
 
 
 def check_statuses(arm, targets, starts, res, rows, tol, max_iter=1000, solve_again=None):
@@ -99,8 +100,7 @@ def check_statuses(arm, targets, starts, res, rows, tol, max_iter=1000, solve_ag
     assert np.all(res.iterations[res.status == "max_iter"] == max_iter)
     looked = np.isin(res.status, ["stalled", "singular", "damped", "fixed_point", "slow"])
     if looked.any():
-        gain, saddle = judged(task, arm, targets[looked], res.theta[looked], rows, tol)
-        big_gain, _ = judged(task, arm, targets[looked], res.theta[looked], rows, tol, margin=2.0)
+        gain, big_gain, saddle = judged(task, arm, targets[looked], res.theta[looked], rows, tol)
         status = res.status[looked]
         wrong = np.where(np.isin(status, ["stalled", "singular"]), big_gain, ~gain)
         wrong |= (status == "singular") & ~saddle
@@ -156,10 +156,10 @@ def test_every_prioritised_status_means_what_it_says(levels):
     T[::3, :3, 3] *= rng.uniform(1.2, 2.5, (12, 1))
     starts = goals + rng.uniform(-1.0, 1.0, goals.shape)
     seen = []
-    for damping in (0.01, 0.2):
+    for damping in (0.2, 0.5):
         method = ik.DLS(damping=damping)
         res = ik.solve_batch(U, T, starts, method=method, levels=levels)
         rows = [np.arange(3), np.arange(3, 6)][:: 1 if levels == (0, 1) else -1]
         again = lambda t, q: ik.solve(U, t, q, method=method, levels=levels)
         seen += check_statuses(U, T, starts, res, rows, float(ik.reach(U)) / 3000, solve_again=again)
-    assert "converged" in seen and "stalled" in seen, seen
+    assert "converged" in seen and {"stalled", "damped", "slow"} & set(seen), seen
