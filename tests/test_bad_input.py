@@ -233,3 +233,54 @@ def test_arms_at_the_documented_size_bounds_solve_as_at_size_one(method):
 def test_a_start_outside_the_limits_is_moved_onto_them():
     res = ik.solve(ARM, [1.0, 1.0], [2.0, 0.0, 0.0], joint_limits=(-1.0, 1.0))
     np.testing.assert_array_equal(res.trace.theta[0], [1.0, 0.0, 0.0])
+
+
+# Issue 40: inputs that were accepted without a meaning, or refused without naming the parameter
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(method=ik.Pinv, rcond=None), "method: expected a method object such as Pinv()"),
+    (dict(method=ik.DLS), r"method: expected a method object such as DLS\(\) .* the class DLS"),
+    (dict(method="jt", damping=-1.0), "damping: expected a number >= 0"),
+    (dict(method="dls", gamma_max=0.0), "gamma_max: expected a number > 0"),
+    (dict(method="pinv", damping=np.nan), "damping: expected a finite number"),
+    (dict(method="dls", rcond=2.0), "rcond: expected a relative cut-off 0 <= rcond < 1"),
+])
+def test_parameters_of_other_methods_are_checked_and_classes_named(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        ik.solve(ARM, [1.0, 1.0], np.zeros(3), **kwargs)
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda: ik.Pinv(rcond=2.0), "rcond: expected a relative cut-off 0 <= rcond < 1"),
+    (lambda: ik.Pinv(rcond=1.0), "rcond: expected a relative cut-off 0 <= rcond < 1"),
+    (lambda: ik.JT(alpha=0.0), "alpha: expected a number > 0"),
+    (lambda: ik.SDLS(gamma_max=0.0), "gamma_max: expected a number > 0"),
+])
+def test_method_parameters_that_would_never_move_are_refused(make, message):
+    with pytest.raises(ValueError, match=message):
+        make()
+
+
+def test_none_means_the_default_for_max_iter_and_stop_rule():
+    """None is "the default" for every option: stop_rule=None is the motion rule (it used to run
+    the report's unit-dependent joint_steps rule), max_iter=None is 1000."""
+    plain = ik.solve(ARM, [3.5, 1.0], np.full(3, 0.1), method="jt")
+    given = ik.solve(ARM, [3.5, 1.0], np.full(3, 0.1), method="jt", stop_rule=None, max_iter=None)
+    report = ik.solve(ARM, [3.5, 1.0], np.full(3, 0.1), method="jt", stop_rule="joint_steps")
+    assert (given.status, given.iterations) == (plain.status, plain.iterations)
+    assert report.iterations != plain.iterations  # the two rules differ here, so None is not it
+    assert ik.Options(stop_rule=None, max_iter=None) == ik.Options()
+
+
+TREE_JOINTS = dict(axes=[[0, 0, 1], [0, 0, 1]], parents=[-1, 0], effector_parents=[1])
+
+
+@pytest.mark.parametrize("scale, message", [
+    (0.0, "positions: expected a positive total link length"),
+    (1e-60, r"positions: expected link lengths of 0 or within \[1e-40"),
+])
+def test_a_tree_of_size_zero_or_below_tiny_is_refused_like_a_chain(scale, message):
+    with pytest.raises(ValueError, match=message):
+        ik.tree(np.array([[0.0, 0, 0], [1, 0, 0]]) * scale, effectors=np.array([[2.0, 0, 0]]) * scale,
+                **TREE_JOINTS)
+    ik.tree(np.array([[0.0, 0, 0], [1, 0, 0]]) * 1e-30, effectors=np.array([[2.0, 0, 0]]) * 1e-30,
+            **TREE_JOINTS)  # above TINY: accepted

@@ -1,3 +1,5 @@
+import collections
+
 import numpy as np
 import pytest
 from hypothesis import given
@@ -85,3 +87,17 @@ def test_fabrik_pass_keeps_link_lengths_when_points_coincide():
     new = np.asarray(fabrik_pass(points, np.ones(3), np.zeros(3)))
     np.testing.assert_allclose(np.linalg.norm(np.diff(new, axis=0), axis=1), [1.0, 1.0, 1.0])
     np.testing.assert_allclose(new[0], points[0])
+
+
+def test_fabrik_never_settles_on_the_ur5_where_ccd_converges():
+    """fabrik.py's note, measured: the UR5's hinges cannot follow FABRIK's free points."""
+    U = ik.core.robots.ur5()
+    rng = np.random.default_rng(1)
+    goals = rng.uniform(-np.pi, np.pi, (20, 6))
+    targets = np.stack([np.asarray(ik.fk(U, g)) for g in goals])
+    starts = goals + rng.uniform(-0.5, 0.5, goals.shape)
+    fabrik = ik.solve_batch(U, targets, starts, method="fabrik")
+    assert collections.Counter(fabrik.status) == {"max_iter": 20}
+    relative = fabrik.error / float(ik.reach(U))
+    assert 0.06 < relative.min() and relative.max() < 0.4
+    assert set(ik.solve_batch(U, targets, starts, method="ccd").status) == {"converged"}

@@ -73,5 +73,5 @@ def test_a_fixed_alpha_is_a_parameter_of_the_jacobian_transpose():
     by_function = ik.solve(ARM, target, START, method=lambda J, e: 0.1 * (J.T @ e), max_iter=300)
     assert (by_method.status, by_method.iterations) == (by_function.status, by_function.iterations)
     np.testing.assert_allclose(by_method.theta, by_function.theta, atol=1e-12)
-    with pytest.raises(ValueError, match="alpha: expected a number >= 0"):
+    with pytest.raises(ValueError, match="alpha: expected a number > 0"):
         ik.JT(alpha=-1.0)

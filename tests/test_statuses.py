@@ -14,6 +14,7 @@ import ikteach as ik
 from ikteach.core import stop_rules
 from ikteach.core._validate import round_finite
 from ikteach.core.levels import rest_gain_bound
+from ikteach.core.problem import Problem
 from ikteach.core.tasks import task_for
 
 UR5_GOAL = np.array([0.3, -1.0, 1.2, 0.4, 0.8, -0.5])
@@ -149,9 +150,10 @@ def test_fabrik_on_a_hinge_chain_stops_at_its_own_fixed_point():
     not a minimum of ||e||; a Jacobian method goes on from there."""
     res = ik.solve(FABRIK_ARM, FABRIK_TARGET, np.zeros(3), method="fabrik")
     assert res.status != "damped" and res.error > 1.0
-    task = task_for(FABRIK_ARM, (3,))
-    kinds = stop_rules.why_stalled(task, FABRIK_ARM, FABRIK_TARGET[None], res.theta[None],
-                                   np.array([True]), ik.Options(tol=NO_LIMITS.tol).resolved(1.0, 3), own_update=True)
+    problem = Problem(task_for(FABRIK_ARM, (3,)), FABRIK_ARM, jnp.asarray(FABRIK_TARGET))
+    kinds = stop_rules.why_stalled(problem, FABRIK_TARGET[None], res.theta[None], np.array([True]),
+                                   ik.Options(tol=NO_LIMITS.tol).resolved(1.0, 3), ((0, 1, 2),),
+                                   own_update=True)
     assert stop_rules.KIND_STATUS[int(kinds[0])] == "fixed_point"
     assert ik.solve(FABRIK_ARM, FABRIK_TARGET, res.theta, method="pinv").converged
 
@@ -170,13 +172,21 @@ def test_a_true_minimum_out_of_reach_still_says_stalled():
 def test_a_rest_gain_above_the_stable_bound_is_refused_with_the_bound():
     arm = ik.planar_chain([1.0] * 5)
     bound = rest_gain_bound(5 / 6)  # the default damping L / 6
-    with pytest.raises(ValueError, match=r"rest_gain: .*below 2 \(1 \+ damping\^2\) = 3\.389.* got 5"):
+    with pytest.raises(ValueError, match=r"rest_gain: .*at most 1 \+ damping\^2 = 1\.694.* got 5"):
         ik.solve(arm, [10.0, 0.0], np.full(5, 0.3), rest_pose=np.zeros(5), rest_gain=5.0)
     with pytest.raises(ValueError, match="rest_gain"):
         ik.track(arm, np.tile([10.0, 0.0], (5, 1)), np.full(5, 0.3), rest_pose=np.zeros(5),
-                 rest_gain=bound)
-    res = ik.solve(arm, [10.0, 0.0], np.full(5, 0.3), rest_pose=np.zeros(5), rest_gain=0.95 * bound)
+                 rest_gain=1.01 * bound)
+    res = ik.solve(arm, [10.0, 0.0], np.full(5, 0.3), rest_pose=np.zeros(5), rest_gain=bound)
     assert np.max(np.abs(res.trace.theta)) < 10, res
+
+
+def test_the_issues_undamped_rest_gain_near_the_old_bound_is_refused():
+    """Issue 40: P3, lambda 0, rest_gain 1.99 (below the old bound 2) drove theta_3 to 33 rad."""
+    with pytest.raises(ValueError, match=r"rest_gain: expected a gain of at most 1 \+ damping\^2 = 1 "):
+        ik.solve(P3, [1.5, 1.0], np.full(3, 0.3), damping=0.0, rest_pose=np.zeros(3), rest_gain=1.99)
+    assert ik.solve(P3, [1.5, 1.0], np.full(3, 0.3), damping=0.0, rest_pose=np.zeros(3),
+                    rest_gain=1.0).converged
 
 
 def test_huge_finite_angles_print_as_numbers():

@@ -28,12 +28,14 @@ def jt_step(J, e):
 @method(data=("alpha",))
 class JT(JacobianMethod):
     """The Jacobian transpose: delta_theta = alpha J^T e with Buss's optimal alpha, or with a
-    fixed step length alpha when one is given (lecture 02 compares the two)."""
+    fixed step length alpha > 0 when one is given (lecture 02 compares the two; alpha = 0
+    would never move)."""
     alpha: float = None
 
     def __post_init__(self):
         if self.alpha is not None:
-            object.__setattr__(self, "alpha", as_number(self.alpha, "alpha", minimum=0))
+            object.__setattr__(self, "alpha", as_number(self.alpha, "alpha", minimum=0,
+                                                           strict=True))
 
     def step(self, J, e):
         if self.alpha is None:

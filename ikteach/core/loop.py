@@ -19,18 +19,21 @@ from .stop_rules import step_size, still_progressing
 
 # What each status means (append only):
 #   converged  ||e|| < tol.
-#   stalled    the steps stopped moving the end effector at a minimum of ||e|| (as far as one
-#              lighter step can tell): out of reach from this start.
+#   stalled    the steps stopped moving the end effector at a minimum of ||e||: a short downhill
+#              run of light steps from there gains no visible change (more than tol and 0.1 % of
+#              ||e||; with priorities, no level gains one while the levels before it hold):
+#              out of reach from this start.
 #   max_iter   max_iter steps taken and no other stop fired (e.g. the pseudoinverse out of
 #              reach: it never settles).
 #   diverged   a non-finite error or step (the last finite theta is kept).
-#   slow       the stall rule fired, but ||e|| still fell by a steady fraction per step.
+#   slow       the stall rule fired while ||e|| still fell by a steady fraction per step, and
+#              the light steps from there still gain.
 #   singular   stalled at a saddle of ||e|| (a singular pose whose error J cannot see).
-#   damped     stalled short of a minimum: J still sees the error, or a lighter step would gain
-#              more than tol (damping, max_step, clamp or a weak direction of J stopped it).
-#   fixed_point  FABRIK or CCD (no max_step) stopped at a fixed point of its own update, not at
-#              a minimum of ||e|| (dls or pinv goes on from there).
-# (singular, damped and fixed_point are told apart from stalled after the loop: stop_rules.py.)
+#   damped     stalled short of a minimum: the light steps still gain (damping, max_step, clamp,
+#              a cut-off or a weak direction of J stopped it).
+#   fixed_point  FABRIK or CCD (no max_step) stopped where the light steps still gain: a fixed
+#              point of its own update, not a minimum of ||e|| (dls or pinv goes on from there).
+# (stalled, slow, singular, damped and fixed_point are settled after the loop: stop_rules.py.)
 STATUSES = ("running", "converged", "stalled", "max_iter", "diverged", "slow", "singular",
             "damped", "fixed_point")
 RUNNING, CONVERGED, STALLED, MAX_ITER, DIVERGED, SLOW, SINGULAR, DAMPED, FIXED_POINT = range(9)

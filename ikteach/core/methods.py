@@ -61,19 +61,27 @@ def as_method(method, **parameters):
     """A method object from a name, an object, or a step function.
 
     With a name, each parameter given goes to the method if it owns it (damping reaches DLS;
-    "jt" has none and ignores it), so one set of keywords serves a loop over method names."""
+    "jt" has none and ignores it, once ik.DLS has checked it), so one set of keywords serves a
+    loop over method names."""
     if isinstance(method, str):
         if method not in METHODS:
             raise ValueError(f"method: expected one of {sorted(METHODS)}, a method object such "
                              f"as ik.DLS(damping=0.2), or a function step(J, e) -> delta_theta, "
                              f"got {method!r:.80}")
         cls = METHODS[method]
-        return cls(**{k: v for k, v in parameters.items()
-                      if v is not None and k in method_parameters(cls)})
+        given = {k: v for k, v in parameters.items() if v is not None}
+        for name, value in given.items():  # one it does not own is still checked by its owner
+            owner = next((c for c in METHODS.values() if name in method_parameters(c)), None)
+            if owner is not None and owner is not cls:
+                owner(**{name: value})
+        return cls(**{k: v for k, v in given.items() if k in method_parameters(cls)})
     if any(v is not None for v in parameters.values()):
         name = next(k for k, v in parameters.items() if v is not None)
         raise ValueError(f"{name}: give it to the method object (e.g. ik.DLS(damping=...)), "
                          f"not beside method={method!r:.60}")
+    if isinstance(method, type):
+        raise ValueError(f"method: expected a method object such as {method.__name__}() (with "
+                         f"its parameters), got the class {method.__name__} itself")
     if hasattr(method, "delta"):
         return method
     if callable(method):

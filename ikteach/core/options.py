@@ -9,10 +9,11 @@ import numpy as np
 
 from ._pytree import pytree_dataclass, replace
 from ._validate import as_array, as_count, as_number, numeric
-from .stop_rules import check_rule
+from .stop_rules import DEFAULT_STOP_RULE, check_rule
 
 TOL_PER_LENGTH = 3000  # tol = L / 3000 (1e-3 for three unit links; L: the arm's size)
 STALL_PER_TOL = 0.01  # stall_tol = tol / 100
+DEFAULT_MAX_ITER = 1000
 MAX_ITER_CAP = 10**6  # the largest max_iter accepted: a full trace of 12 joints is then 100 MB
 LIMIT_MODES = ("clamp", "clamping_loop")
 
@@ -22,12 +23,12 @@ LIMIT_MODES = ("clamp", "clamping_loop")
                   meta=("stop_rule", "limit_mode"))
 class Options:
     """tol       stop "converged" when ||e|| < tol (a length; default L / 3000).
-    max_iter  stop "max_iter" after this many steps (at most MAX_ITER_CAP).
+    max_iter  stop "max_iter" after this many steps (at most MAX_ITER_CAP; None: the default).
     clamp     Buss's D_max: each end effector's error is clamped to at most D_max.
     max_step  cap on any joint's change per step, in radians.
     stall_tol stop when the last step's size < stall_tol (default tol / 100; 0: never).
     stop_rule the step's size: "motion" (||J delta_theta||, scale-free, the default) or
-              "joint_steps" (the report's sum |delta_theta_i|). See stop_rules.py.
+              "joint_steps" (the report's sum |delta_theta_i|); None: the default. See stop_rules.py.
     joint_limits  (lower, upper): numbers or per-joint arrays, +-inf for no limit.
     limit_mode    "clamping_loop" (default for Jacobian methods) or "clamp" (joint_limits.py).
     levels    priority of each target block, 0 first (levels.py); rest_pose, rest_gain: a last
@@ -35,11 +36,11 @@ class Options:
     weights   for a 4x4 pose target: (position_weight, orientation_weight), default (1, 1).
     """
     tol: float = None
-    max_iter: int = 1000
+    max_iter: int = DEFAULT_MAX_ITER
     clamp: float = None
     max_step: float = None
     stall_tol: float = None
-    stop_rule: str = "motion"
+    stop_rule: str = DEFAULT_STOP_RULE
     joint_limits: tuple = None
     limit_mode: str = None
     levels: tuple = None
@@ -60,6 +61,9 @@ class Options:
             "rest_pose": lambda v: as_array(v, "rest_pose", ndim=1),
             "rest_gain": lambda v: as_number(v, "rest_gain", minimum=0, strict=True),
         }
+        for name, default in (("max_iter", DEFAULT_MAX_ITER), ("stop_rule", DEFAULT_STOP_RULE)):
+            if getattr(self, name) is None:  # None: the default, as for every other field
+                object.__setattr__(self, name, default)
         for name, fix in check.items():
             if getattr(self, name) is not None:
                 object.__setattr__(self, name, fix(getattr(self, name)))

@@ -55,7 +55,12 @@ class Pinv(JacobianMethod):
     rcond: float = DEFAULT_RCOND
 
     def __post_init__(self):
-        object.__setattr__(self, "rcond", as_number(self.rcond, "rcond", minimum=0))
+        rcond = as_number(self.rcond, "rcond", minimum=0)
+        if rcond >= 1:
+            raise ValueError(f"rcond: expected a relative cut-off 0 <= rcond < 1 (singular values "
+                             f"below rcond sigma_max are dropped; from 1 on every step is 0), "
+                             f"got {rcond:g}")
+        object.__setattr__(self, "rcond", rcond)
 
     def step(self, J, e):
         if J.shape[0] == 2:

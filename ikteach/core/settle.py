@@ -32,13 +32,22 @@ def stretched_matrices(arm):
     return np.outer(tail, tail), A
 
 
-def settle_factor(arm, distance, damping, clamp=None):
-    """Spectral radius of M: below 1, DLS settles stretched; above 1, it does not."""
-    d = distance if clamp is None else min(distance, clamp)
+def settle_matrix(arm, distance, damping, clamp=None):
+    """M, the DLS step's map delta <- M delta near the stretched pose (joint angles).
+
+    Unclamped, J^T e = -(J^T J + d A) delta to first order. Buss's clamp scales e by D / ||e||,
+    D = min(d, D_max), and J^T e is already first order, so the step sees D / d of it:
+        M = (J^T J + lambda^2 I)^-1 ((1 - D/d) J^T J + lambda^2 I - D A),
+    which is (J^T J + lambda^2 I)^-1 (lambda^2 I - d A) when the clamp does not act (D = d)."""
+    D = distance if clamp is None else min(distance, clamp)
     JtJ, A = stretched_matrices(arm)
     eye = np.eye(len(A))
-    M = np.linalg.solve(JtJ + damping**2 * eye, damping**2 * eye - d * A)
-    return float(np.abs(np.linalg.eigvals(M)).max())
+    return np.linalg.solve(JtJ + damping**2 * eye, (1 - D / distance) * JtJ + damping**2 * eye - D * A)
+
+
+def settle_factor(arm, distance, damping, clamp=None):
+    """Spectral radius of M (settle_matrix): below 1, DLS settles stretched; above 1, it does not."""
+    return float(np.abs(np.linalg.eigvals(settle_matrix(arm, distance, damping, clamp))).max())
 
 
 def smallest_settling_damping(arm, distance, clamp=None):

@@ -1,7 +1,8 @@
 """ik.solve: the loop of loop.py from theta0 until a stop rule fires, with its trace.
 
-After the loop, a "stalled" solve is looked at where it stopped (stop_rules.why_stalled):
-a saddle of ||e|| becomes "singular", a stop while J still sees the error "damped".
+After the loop, a "stalled" or "slow" solve is looked at where it stopped
+(stop_rules.why_stalled): a saddle of ||e|| becomes "singular", a stop where a short run of
+light steps still gains "damped", and "slow" stays "slow" only while such steps still gain.
 """
 import dataclasses
 
@@ -13,7 +14,7 @@ from ._pytree import replace
 from ._validate import as_array, round_finite
 from .joint_limits import with_limits
 from .levels import with_priorities
-from .loop import CONVERGED, RUNNING, STALLED, STATUSES, iterate, start
+from .loop import CONVERGED, RUNNING, SLOW, STALLED, STATUSES, iterate, start
 from .methods import METHODS, as_method, check_method_target, traceable
 from .options import Options
 from .problem import Problem
@@ -107,21 +108,23 @@ def prepare(arm, target, theta0, method, options, method_parameters, rows=None):
 
 
 def explain_stalls(problem, method, options, targets, thetas, status):
-    """status with each STALLED row looked at where it stopped (stop_rules.why_stalled): a
-    saddle of ||e|| becomes SINGULAR, a stop short of a minimum DAMPED, and FABRIK's or CCD's
-    own fixed point FIXED_POINT; priority levels are judged level by level."""
+    """status with each STALLED or SLOW row looked at where it stopped (stop_rules.why_stalled):
+    a minimum of ||e|| says STALLED, a saddle SINGULAR, a stop short of a minimum DAMPED (or
+    FABRIK's or CCD's own fixed point FIXED_POINT); a SLOW row stays SLOW only while a light
+    step still gains. Priority levels are judged level by level."""
     status = np.array(status)
-    stalled = status == STALLED
+    looked = (status == STALLED) | (status == SLOW)
+    if not looked.any():
+        return status
+    rows = jax.eval_shape(problem.error, np.asarray(thetas)[0]).shape[0]
     inner = getattr(method, "inner", method)  # within joint limits: the method inside
-    levels = None
-    if hasattr(inner, "rows_by_level") and stalled.any():
-        rows = jax.eval_shape(problem.error, np.asarray(thetas)[0]).shape[0]
-        levels = tuple(tuple(int(i) for i in r) for r in inner.rows_by_level(rows))
+    by_level = inner.rows_by_level(rows) if hasattr(inner, "rows_by_level") else [range(rows)]
+    levels = tuple(tuple(int(i) for i in r) for r in by_level)
     own_update = not method.uses_jacobian and not np.isfinite(options.max_step)
-    kinds = stop_rules.why_stalled(problem.task, problem.arm, targets, thetas, stalled, options,
-                                   levels, own_update)
-    named = np.array([STATUSES.index(name) for name in stop_rules.KIND_STATUS])
-    return np.where(stalled, named[kinds], status)
+    kinds = stop_rules.why_stalled(problem, targets, thetas, looked, options, levels, own_update)
+    named = np.array([STATUSES.index(name) for name in stop_rules.KIND_STATUS])[kinds]
+    still_slow = (status == SLOW) & np.isin(kinds, (stop_rules.CUT_SHORT, stop_rules.FIXED_POINT))
+    return np.where(looked & ~still_slow, named, status)
 
 
 def solve(arm, target, theta0, method="dls", options=None, *, damping=None, rcond=None,

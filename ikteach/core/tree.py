@@ -15,6 +15,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ._validate import as_array
+from .chain import check_link_lengths
 from .kinematics import rotation_about
 
 
@@ -79,7 +80,13 @@ def tree(positions, axes, parents, effectors, effector_parents):
     if m == 0:
         raise ValueError("effectors: expected at least one end effector, got none")
     effector_parents = _indices(effector_parents, "effector_parents", m, lambda i: (0, n))
-    return Tree(positions, axes / norms[:, None], effectors, parents, effector_parents)
+    arm = Tree(positions, axes / norms[:, None], effectors, parents, effector_parents)
+    try:
+        check_link_lengths(tree_links(arm), "positions")
+    except ValueError as err:  # the links are spans between the given points
+        raise ValueError(f"{err} (the tree's links: each joint to its parent, each effector "
+                         f"to its joint)") from None
+    return arm
 
 
 def ancestors(arm):
@@ -183,13 +190,18 @@ def tree_jacobian_autodiff(arm, theta):
     return jax.jacfwd(lambda t: tree_fk(arm, t).reshape(-1))(jnp.asarray(theta, dtype=float))
 
 
+def tree_links(arm):
+    """The lengths of the tree's links: each joint to its parent, each effector to its joint."""
+    rest = np.asarray(arm.positions)
+    joints = [np.linalg.norm(rest[j] - rest[p]) for j, p in enumerate(arm.parents) if p >= 0]
+    ends = [np.linalg.norm(np.asarray(arm.effectors)[k] - rest[j])
+            for k, j in enumerate(arm.effector_parents)]
+    return np.asarray(joints + ends, dtype=float)
+
+
 def tree_size(arm):
     """Total length of the tree's links (joint to parent joint, effector to its joint)."""
-    rest = np.asarray(arm.positions)
-    total = sum(np.linalg.norm(rest[j] - rest[p]) for j, p in enumerate(arm.parents) if p >= 0)
-    total += sum(np.linalg.norm(np.asarray(arm.effectors)[k] - rest[j])
-                 for k, j in enumerate(arm.effector_parents))
-    return float(total)
+    return float(np.sum(tree_links(arm)))
 
 
 @dataclasses.dataclass(frozen=True)
