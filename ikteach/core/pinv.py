@@ -29,16 +29,15 @@ def pinv_two_rows(J, e, rcond=DEFAULT_RCOND):
     One plane rotation R_psi makes the rows of S = R_psi J orthogonal (R_psi J J^T R_psi^T
     diagonal): then row i of S is sigma_i v_i^T (in some order), the singular values are the
     row lengths and J^+ e = sum_i (R_psi e)_i / sigma_i^2 (row i of S), with pinv_step's cut-off.
-    tan(psi) is the root of tan^2 + 2 zeta tan - 1 = 0 of magnitude <= 1, zeta = (g22 - g11) / (2 g12)
-    for J J^T = [[g11, g12], [g12, g22]] (lecture 03 derives it and checks it against pinv_step;
-    benchmarks/small_solves.py times it against the SVD).
+    tan(psi) is the root of tan^2 + 2 zeta tan - 1 = 0 of magnitude <= 1, with
+    zeta = ([JJ^T]_22 - [JJ^T]_11) / (2 [JJ^T]_12) (lecture 03 derives it and checks it against
+    pinv_step; benchmarks/small_solves.py times it against the SVD).
     """
     J, e = jnp.asarray(J), jnp.asarray(e)
     JJt = J @ J.T
-    g11, g22, g12 = JJt[0, 0], JJt[1, 1], JJt[0, 1]
-    zeta = (g22 - g11) / (2.0 * jnp.where(g12 == 0, 1.0, g12))
+    zeta = (JJt[1, 1] - JJt[0, 0]) / (2.0 * jnp.where(JJt[0, 1] == 0, 1.0, JJt[0, 1]))
     tan_psi = jnp.where(zeta >= 0, 1.0, -1.0) / (jnp.abs(zeta) + jnp.sqrt(1.0 + zeta * zeta))
-    tan_psi = jnp.where(g12 == 0, 0.0, tan_psi)  # rows already orthogonal
+    tan_psi = jnp.where(JJt[0, 1] == 0, 0.0, tan_psi)  # rows already orthogonal
     cos = 1.0 / jnp.sqrt(1.0 + tan_psi * tan_psi)
     sin = cos * tan_psi
     R_psi = jnp.stack([jnp.stack([cos, -sin]), jnp.stack([sin, cos])])
