@@ -10,7 +10,8 @@ is a NamedTuple with fields i, theta, error and status; it is running while stat
   run_eager    the same, one Python pass at a time, for step functions JAX cannot trace;
   run_queue    ik.solve_batch: jax.vmap of step over `slots` targets in flight; a slot whose
                target has finished takes the next one (the work is the sum of the iterations,
-               not the batch size times the largest count); split over CPU devices when several;
+               not the batch size times the largest count); batches padded to a few sizes
+               (bucket) so a new batch size rarely compiles; split over CPU devices when several;
   run_scan     ik.track: jax.lax.scan of one step per time step, SCAN_CHUNK steps per program;
   until_stopped  the loop as one traceable while_loop, for a caller's own compiled program.
 """
@@ -22,11 +23,13 @@ import jax.numpy as jnp
 import numpy as np
 
 from . import jit as runtime_jit
+from .shared import as_data
 
 RUNNING = 0  # the loop's status while it runs (ikteach/core/loop.py)
 TRACE_CHUNK = 256  # passes per compiled run when the trace is kept
 SLOTS = 1024  # targets in flight at once (per device)
 SPLIT_FROM = 512  # targets per device below which a batch stays on one device
+MIN_BUCKET = 16  # the smallest padded batch (ikteach/core/batch.py runs up to 8 one by one)
 STEPS_PER_REFILL = 4  # passes between refills (a refill costs more than a pass)
 SCAN_CHUNK = 128  # time steps per compiled scan: paths of any length reuse one program
 
@@ -70,7 +73,7 @@ def _traced_chunk(step, args, state):
 def run_traced(step, args, state):
     """Run step until the state stops, chunk by chunk; returns the last state (numpy) and the
     trace: theta (k + 1, n) and error (k + 1,) for the k steps taken."""
-    state, thetas, errors = host_state(state), [], []
+    args, state, thetas, errors = as_data(args), host_state(state), [], []
     while True:
         first = int(state.i)
         state, chunk_thetas, chunk_errors = jax.device_get(_traced_chunk(step, args, state))
@@ -103,12 +106,21 @@ def _select(mask, a, b):
         lambda x, y: jnp.where(mask.reshape(mask.shape + (1,) * (x.ndim - 1)), x, y), a, b)
 
 
-def _queue(step, start, args, rows, starts, slots):
-    """Every row solved, `slots` at a time: step(args, row, state) -> state, start(theta0) -> state."""
-    count = starts.shape[0]
+def bucket(count):
+    """The row count a batch of `count` rows is padded to: the next power of two, at least
+    MIN_BUCKET. Batches of 9, 10 or 16 rows then share one program, 257 and 500 another; the
+    padded rows are idle slots, never solved."""
+    return max(MIN_BUCKET, 1 << (int(count) - 1).bit_length())
+
+
+def _queue(step, start, args, rows, starts, count, slots):
+    """The first `count` rows solved, `slots` at a time (rows past count are padding):
+    step(args, row, state) -> state, start(theta0) -> state."""
+    count = jnp.reshape(count, ())  # traced: a new batch size in the same bucket compiles nothing
     pick = lambda index: jax.tree_util.tree_map(lambda r: r[jnp.minimum(index, count - 1)], rows)
     one_pass = jax.vmap(lambda row, s: same_types(step(args, row, s), s))
     fresh = jax.vmap(start)
+    size = starts.shape[0]
 
     def load(index):  # fresh states for these rows; an index past the end marks an idle slot
         state = fresh(starts[jnp.minimum(index, count - 1)])
@@ -122,7 +134,7 @@ def _queue(step, start, args, rows, starts, slots):
             s.status == RUNNING, one_pass(row, s), s), state)
         done = running & (state.status != RUNNING)
         out = jax.tree_util.tree_map(
-            lambda o, x: o.at[jnp.where(done, index, count)].set(x, mode="drop"), out, state)
+            lambda o, x: o.at[jnp.where(done, index, size)].set(x, mode="drop"), out, state)
         free = state.status != RUNNING
         index = jnp.where(free, queued + jnp.cumsum(free) - 1, index)
         state = _select(free, load(index), state)
@@ -154,13 +166,14 @@ def _mesh(devices):
 
 
 @partial(runtime_jit.jit, static_argnames=("step", "start", "slots", "mesh"))
-def _run_split(step, start, args, rows, starts, slots, mesh):
-    """_queue on every device of the mesh, each on its share of the rows."""
+def _run_split(step, start, args, rows, starts, counts, slots, mesh):
+    """_queue on every device of the mesh, each on its share of the rows (counts: how many
+    of each device's rows are real)."""
     shard_map, check_off = _shard_map()
     P = jax.sharding.PartitionSpec
-    share = lambda args, rows, starts: _queue(step, start, args, rows, starts, slots)
-    return shard_map(share, mesh=mesh, in_specs=(P(), P("rows"), P("rows")),
-                     out_specs=P("rows"), **check_off)(args, rows, starts)
+    share = lambda args, rows, starts, count: _queue(step, start, args, rows, starts, count, slots)
+    return shard_map(share, mesh=mesh, in_specs=(P(), P("rows"), P("rows"), P("rows")),
+                     out_specs=P("rows"), **check_off)(args, rows, starts, counts)
 
 
 def split_devices(count):
@@ -172,20 +185,31 @@ def split_devices(count):
     return tuple(devices)
 
 
+def _padded(x, size):
+    """x with its rows padded to `size` by copies of the last row (never solved)."""
+    x = np.asarray(x)
+    return np.concatenate([x, np.repeat(x[-1:], size - x.shape[0], axis=0)])
+
+
 def run_queue(step, start, args, rows, starts):
-    """Final states of every row (numpy). Over several devices, device k takes rows k, k + D,
-    k + 2D, ... (neighbouring rows cost alike, so the shares take about as long), the rows
-    padded to a multiple of D with copies of the last one, dropped again."""
-    count = starts.shape[0]
+    """Final states of every row (numpy). The rows are padded to bucket(count), so batches of
+    nearby sizes share one program. Over several devices, device k takes rows k, k + D,
+    k + 2D, ... (neighbouring rows cost alike, so the shares take about as long)."""
+    count, args = starts.shape[0], as_data(args)
     devices = split_devices(count)
     if devices is None:
-        return jax.device_get(_run_queue(step, start, args, rows, starts, min(SLOTS, count)))
+        size = bucket(count)
+        pad = lambda x: _padded(x, size)
+        state = _run_queue(step, start, args, jax.tree_util.tree_map(pad, rows), pad(starts),
+                           np.int64(count), min(SLOTS, size))
+        return jax.tree_util.tree_map(lambda x: np.asarray(x)[:count], jax.device_get(state))
     d = len(devices)
-    share = -(-count // d)
-    order = np.minimum(np.arange(share * d).reshape(share, d).T.ravel(), count - 1)
+    share = bucket(-(-count // d))
+    order = np.minimum(np.arange(d)[:, None] + d * np.arange(share)[None, :], count - 1).ravel()
+    counts = np.array([len(range(k, count, d)) for k in range(d)], dtype=np.int64)
     take = lambda x: np.asarray(x)[order]
     state = _run_split(step, start, args, jax.tree_util.tree_map(take, rows), take(starts),
-                       min(SLOTS, share), _mesh(devices))
+                       counts, min(SLOTS, share), _mesh(devices))
     back = np.arange(count)
     back = (back % d) * share + back // d  # where row r went
     return jax.tree_util.tree_map(lambda x: np.asarray(x)[back], state)
@@ -203,7 +227,7 @@ def run_scan(step, args, carry, rows):
     """step(args, carry, row) -> (carry, out) over the rows, SCAN_CHUNK rows per compiled run
     (the last chunk padded with copies of the last row, its extra outputs dropped); returns
     the outputs stacked (numpy)."""
-    count = jax.tree_util.tree_leaves(rows)[0].shape[0]
+    count, args = jax.tree_util.tree_leaves(rows)[0].shape[0], as_data(args)
     pad = lambda x: np.concatenate([x, np.repeat(x[-1:], -count % SCAN_CHUNK, axis=0)])
     rows = jax.tree_util.tree_map(lambda x: pad(np.asarray(x)), rows)
     carry, outs = host_state(carry), []

@@ -9,16 +9,17 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ._pytree import replace
 from ._validate import as_array, round_finite
 from .joint_limits import with_limits
 from .levels import with_priorities
 from .loop import CONVERGED, RUNNING, STALLED, STATUSES, iterate, start
-from .methods import as_method, check_method_target, traceable
+from .methods import METHODS, as_method, check_method_target, traceable
 from .options import Options
 from .problem import Problem
 from .tasks import task_for
 from . import stop_rules
-from .._runtime import engine
+from .._runtime import engine, shared
 
 
 class StopSolve(Exception):
@@ -97,7 +98,11 @@ def prepare(arm, target, theta0, method, options, method_parameters, rows=None):
     theta0 = np.clip(theta0, *options.joint_limits)
     method = with_priorities(method, problem, theta0.reshape(-1, n)[0], options)
     check_method_target(method, problem, name)
+    if options.levels is None and options.rest_pose is None:  # one program for every method
+        method = shared.one_of(method, tuple(METHODS.values()), L)  # (ikteach/_runtime/shared.py)
     method = with_limits(method, options)
+    # what the task and method were built from: the loop needs none of it
+    options = replace(options, levels=None, rest_pose=None, rest_gain=None, weights=None)
     return problem, method, options, theta0, target
 
 

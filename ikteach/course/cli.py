@@ -5,6 +5,7 @@
     ikteach site [--out build/site]                         the course as a static book
     ikteach slides [--out build/slides] [NOTEBOOK ...]      reveal.js decks of the lectures
     ikteach header [--check]                                Colab cells and badges from pyproject.toml
+    ikteach warm [NOTEBOOK ...] [--cache DIR]               compile the lectures' solvers before class
 
 The names stay when the modules behind them move: a lecturer's script calls `ikteach grade`,
 never a module path. `ikteach COMMAND --help` shows a command's own options.
@@ -19,6 +20,7 @@ COMMANDS = {
     "site": ("ikteach.course.book", "build the course as a static HTML book (build/site)"),
     "slides": ("ikteach.course.slides", "build reveal.js slides of the lectures (build/slides)"),
     "header": ("ikteach.course.notebook_header", "write the Colab cells and badges (make header)"),
+    "warm": ("ikteach.course.warm", "compile every lecture's solvers into the cache, before class"),
 }
 
 
