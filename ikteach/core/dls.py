@@ -26,23 +26,23 @@ def dls_step(J, e, damping):
 def dls_step_small(J, e, damping):
     """dls_step for J with m <= 3 rows, the m x m inverse in closed form (Cramer's rule):
 
-        A^-1 = adj(A) / det(A),   A = J J^T + lambda^2 I;
-        m = 2:  adj(A) = [[A_11, -A_01], [-A_10, A_00]],   det(A) = A_00 A_11 - A_01 A_10;
-        m = 3:  adj(A) has rows A_1 x A_2, A_2 x A_0, A_0 x A_1 (A symmetric), det(A) = A_0 . (A_1 x A_2).
+        B^-1 = adj(B) / det(B),   B = J J^T + lambda^2 I   (B_rc: row r, column c; B_r: row r);
+        m = 2:  adj(B) = [[B_22, -B_12], [-B_21, B_11]],   det(B) = B_11 B_22 - B_12 B_21;
+        m = 3:  adj(B) has rows B_2 x B_3, B_3 x B_1, B_1 x B_2 (B symmetric), det(B) = B_1 . (B_2 x B_3).
 
-    The same step as dls_step to rounding (lecture 04 checks it); a batch of targets solves
-    these small systems about twice as fast as LU (the 256 x 256 sweep: 0.52 s against 1.02 s).
+    The same step as dls_step to rounding (lecture 04 checks it); benchmarks/small_solves.py
+    times it against dls_step's LU solve. (Arrays index from 0: B[0, 0] is B_11.)
     """
     J, e = jnp.asarray(J), jnp.asarray(e)
     m = J.shape[0]
-    A = J @ J.T + damping**2 * jnp.eye(m)
+    B = J @ J.T + damping**2 * jnp.eye(m)
     if m == 1:
-        return J.T @ (e / A[0, 0])
+        return J.T @ (e / B[0, 0])
     if m == 2:
-        adj = jnp.array([[A[1, 1], -A[0, 1]], [-A[1, 0], A[0, 0]]])
-        return J.T @ (adj @ e) / (A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0])
-    adj = jnp.stack([jnp.cross(A[1], A[2]), jnp.cross(A[2], A[0]), jnp.cross(A[0], A[1])])
-    return J.T @ (adj @ e) / jnp.dot(A[0], adj[0])
+        adj = jnp.array([[B[1, 1], -B[0, 1]], [-B[1, 0], B[0, 0]]])
+        return J.T @ (adj @ e) / (B[0, 0] * B[1, 1] - B[0, 1] * B[1, 0])
+    adj = jnp.stack([jnp.cross(B[1], B[2]), jnp.cross(B[2], B[0]), jnp.cross(B[0], B[1])])
+    return J.T @ (adj @ e) / jnp.dot(B[0], adj[0])
 
 
 @jax.jit

@@ -18,10 +18,11 @@ def rotation_about(axis, angle):
 
 @jax.jit
 def joint_frames(arm, theta):
-    """World joint positions p_0..p_n (p_n the end effector), world axes z_0..z_{n-1}
-    and the end effector's rotation R.
+    """World positions p_1..p_n of the joints and p_e of the end effector (rows 0..n: row i-1
+    is p_i, p_1 the base), world axes z_1..z_n (row i-1 is z_i) and the end effector's rotation R.
 
-    p_{i+1} = p_i + R_i o_i,  R_i = R_{i-1} Rot(a_i, theta_i),  z_i = R_{i-1} a_i.
+    p_{i+1} = p_i + R_i o_i (p_{n+1} = p_e),  R_i = R_{i-1} Rot(a_i, theta_i),  z_i = R_{i-1} a_i,
+    R_0 = I; a_i is joint i's axis in its parent link's frame, o_i link i's offset (arrays index from 0).
     """
     def link(carry, joint):
         R, p = carry

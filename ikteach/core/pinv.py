@@ -26,26 +26,26 @@ def pinv_step(J, e, rcond=DEFAULT_RCOND):
 def pinv_two_rows(J, e, rcond=DEFAULT_RCOND):
     """pinv_step for a 2 x n Jacobian (planar position targets) without an SVD call.
 
-    One Jacobi rotation R makes the rows of U = R J orthogonal: then J = R^T U, the singular
-    values are the row lengths |u_i| and J^+ e = sum_i (R e)_i u_i / |u_i|^2, with the same
-    cut-off as pinv_step (lecture 03 derives it and checks it against pinv_step). A batch of
-    SVDs of 2 x n matrices costs about 6x more than this arithmetic (a 128 x 128 workspace sweep:
-    10.5 s against 1.7 s).
+    One plane rotation R_psi makes the rows of S = R_psi J orthogonal (R_psi J J^T R_psi^T
+    diagonal): then row i of S is sigma_i v_i^T (in some order), the singular values are the
+    row lengths and J^+ e = sum_i (R_psi e)_i / sigma_i^2 (row i of S), with pinv_step's cut-off.
+    tan(psi) is the root of tan^2 + 2 zeta tan - 1 = 0 of magnitude <= 1, with
+    zeta = ([JJ^T]_22 - [JJ^T]_11) / (2 [JJ^T]_12) (lecture 03 derives it and checks it against
+    pinv_step; benchmarks/small_solves.py times it against the SVD).
     """
     J, e = jnp.asarray(J), jnp.asarray(e)
-    G = J @ J.T
-    a, b, c = G[0, 0], G[1, 1], G[0, 1]
-    zeta = (b - a) / (2.0 * jnp.where(c == 0, 1.0, c))
-    t = jnp.where(zeta >= 0, 1.0, -1.0) / (jnp.abs(zeta) + jnp.sqrt(1.0 + zeta * zeta))
-    t = jnp.where(c == 0, 0.0, t)  # rows already orthogonal
-    cos = 1.0 / jnp.sqrt(1.0 + t * t)
-    sin = cos * t
-    R = jnp.stack([jnp.stack([cos, -sin]), jnp.stack([sin, cos])])
-    U = R @ J
-    sigma = jnp.sqrt(jnp.diagonal(U @ U.T))
+    JJt = J @ J.T
+    zeta = (JJt[1, 1] - JJt[0, 0]) / (2.0 * jnp.where(JJt[0, 1] == 0, 1.0, JJt[0, 1]))
+    tan_psi = jnp.where(zeta >= 0, 1.0, -1.0) / (jnp.abs(zeta) + jnp.sqrt(1.0 + zeta * zeta))
+    tan_psi = jnp.where(JJt[0, 1] == 0, 0.0, tan_psi)  # rows already orthogonal
+    cos = 1.0 / jnp.sqrt(1.0 + tan_psi * tan_psi)
+    sin = cos * tan_psi
+    R_psi = jnp.stack([jnp.stack([cos, -sin]), jnp.stack([sin, cos])])
+    S = R_psi @ J                                      # rows sigma_i v_i^T
+    sigma = jnp.sqrt(jnp.diagonal(S @ S.T))
     keep = (sigma >= rcond * jnp.max(sigma)) & (sigma > 0)
-    weight = jnp.where(keep, (R @ e) / jnp.where(keep, sigma * sigma, 1.0), 0.0)
-    return U.T @ weight
+    weight = jnp.where(keep, (R_psi @ e) / jnp.where(keep, sigma * sigma, 1.0), 0.0)
+    return S.T @ weight
 
 
 @method(data=("rcond",))

@@ -9,8 +9,9 @@ L is the arm's reach (the sum of its link lengths, ik.reach): an angle times a l
 length, so every entry of e is a length and the solve's lengths (tol = L / 3000, damping
 lambda = L / 6, stall_tol = tol / 100) mean the same at every unit. Scale the arm by s and
 e, J and those lengths all scale by s: metres and millimetres give the same steps. With
-the default weights, "converged" (||e|| < tol) means a position error below tol and an
-orientation error below tol / L radians (1/3000 rad with the default tol) - both at once.
+the default weights, "converged" (||e|| < tol) means ||e_p||^2 + L^2 ||e_o||^2 < tol^2: a position
+error below tol and an orientation error below tol / L radians (1/3000 rad with the default
+tol), and more than both - each at 0.9 of its bound is not converged (0.9^2 + 0.9^2 > 1).
 
 log(R_t R^T) is the rotation vector omega with R_t = exp([omega]x) R: the small rotation
 that takes the current hand to the target, in world coordinates. Its derivative at

@@ -1,15 +1,15 @@
 """Selectively damped least squares (Buss & Kim 2005): damp each singular direction by itself.
 
-With J = sum_i sigma_i u_i v_i^T, the pseudoinverse step is sum_i (alpha_i / sigma_i) v_i,
-alpha_i = u_i . e. SDLS bounds how far each term may turn the joints, by comparing how far
-the end effectors are asked to move along u_i (N_i) with how far they would move if the
-joints turned as 1/sigma_i v_i asks (M_i):
+With J = sum_i sigma_i u_i v_i^T, the pseudoinverse step is sum_i (c_i / sigma_i) v_i,
+c_i = u_i . e. SDLS bounds how far each term may turn the joints, by comparing how far
+the end effectors are asked to move along u_i (n_hat_i; Buss & Kim's N_i) with how far they
+would move if the joints turned as 1/sigma_i v_i asks (m_hat_i; their M_i):
 
-  N_i = sum_k ||u_{k,i}||                       (u_{k,i}: effector k's rows of u_i)
-  M_i = (1/sigma_i) sum_l |v_{l,i}| sum_k ||J_{k,l}||   (J_{k,l}: effector k's rows of column l)
-  gamma_i = min(1, N_i / M_i) gamma_max
-  phi_i = ClampMaxAbs((alpha_i / sigma_i) v_i, gamma_i)
-  delta_theta = ClampMaxAbs(sum_i phi_i, gamma_max)
+  n_hat_i = sum_k ||u_i^(k)||                    (u_i^(k): effector k's rows of u_i)
+  m_hat_i = (1/sigma_i) sum_l |[v_i]_l| sum_k ||J^(k)_l||   (J^(k)_l: effector k's rows of column l)
+  gamma_i = min(1, n_hat_i / m_hat_i) gamma_max  (n_hat_i <= m_hat_i: the min is the ratio)
+  Delta_i = ClampMaxAbs((c_i / sigma_i) v_i, gamma_i)
+  delta_theta = ClampMaxAbs(sum_i Delta_i, gamma_max)
 
 ClampMaxAbs(w, d) scales w down so that max_l |w_l| <= d (ik.cap_step). The paper uses
 gamma_max = pi/4; so no joint ever turns by more than gamma_max in one step.
@@ -48,12 +48,12 @@ def block_norms(A, block):
 
 
 def sdls_gamma(U, sigma, Vt, J, gamma_max, block):
-    """gamma_i = min(1, N_i / M_i) gamma_max for every singular direction i (see module doc)."""
-    N = block_norms(U, block).sum(axis=0)
-    column_size = block_norms(J, block).sum(axis=0)              # sum_k ||J_{k,l}||
+    """gamma_i = min(1, n_hat_i / m_hat_i) gamma_max for every singular direction i (module doc)."""
+    n_hat = block_norms(U, block).sum(axis=0)
+    column_size = block_norms(J, block).sum(axis=0)              # sum_k ||J^(k)_l||
     safe_sigma = jnp.where(kept(sigma), sigma, 1.0)
-    M = (jnp.abs(Vt) @ column_size) / safe_sigma
-    ratio = jnp.where(M > 0, N / jnp.where(M > 0, M, 1.0), 1.0)
+    m_hat = (jnp.abs(Vt) @ column_size) / safe_sigma
+    ratio = jnp.where(m_hat > 0, n_hat / jnp.where(m_hat > 0, m_hat, 1.0), 1.0)
     return gamma_max * jnp.minimum(1.0, ratio)
 
 
@@ -79,8 +79,8 @@ def sdls_step(J, e, gamma_max=GAMMA_MAX, block=None, soft=False):
         total = jax.vmap(soft_rescale)(coeff[:, None] * Vt, gamma).sum(axis=0)
         largest = jnp.max(jnp.abs(total))
         return jnp.where(largest > gamma_max, total * (gamma_max / (gamma_max + largest)), total)
-    phi = jax.vmap(cap_step)(coeff[:, None] * Vt, gamma)          # one row per direction
-    return cap_step(phi.sum(axis=0), gamma_max)
+    terms = jax.vmap(cap_step)(coeff[:, None] * Vt, gamma)        # Delta_i, one row per direction
+    return cap_step(terms.sum(axis=0), gamma_max)
 
 
 @method(data=("gamma_max",))

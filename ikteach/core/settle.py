@@ -7,10 +7,14 @@ deviation delta, the DLS step is linear in delta:
 
     delta <- M delta,   M = (J^T J + lambda^2 I)^-1 (lambda^2 I - d A),
 
-where A_ij = sum of the lengths of links k >= max(i, j) (-A is the Hessian of the tip's
-distance from the base at the stretched pose). DLS settles (the step shrinks, the stall rule
-fires: "stalled") when the spectral radius of M is below 1; otherwise it swings around the
-stretched pose until max_iter. A larger lambda settles; a larger d needs a larger lambda.
+where A_ij = sum of the lengths of links k >= max(i, j) (-A is the Hessian of r^T F, the tip's
+reach along r, at the stretched pose; the Hessian of the tip's distance from the base is
+J^T J / L - A, L the reach: lecture 05). DLS settles (the step shrinks, the stall rule fires:
+"stalled") when the spectral radius of M is below 1; otherwise the stretched pose repels it and
+it runs to max_iter, swinging about that pose when lambda is just below the threshold or
+wandering far from it, even folding up, when lambda is small (lecture 04). This linear model
+covers only the neighbourhood of the stretched pose. A larger lambda settles; a larger d needs
+a larger lambda.
 Buss's clamp limits the error the step sees to D_max, so d is replaced by min(d, D_max).
 """
 import numpy as np
