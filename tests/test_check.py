@@ -281,6 +281,54 @@ def test_a_wrapper_of_ikteachs_answer_is_told_what_the_grader_gives(number, func
     assert capsys.readouterr().out.strip() == verdict.message
 
 
+def jt_imported_inside(J, e):
+    from ikteach.core.jt import jt_step as step  # a function-level import
+    return np.asarray(step(J, e))
+
+
+def jt_by_getattr(J, e):
+    return np.asarray(getattr(ik, "jt_step")(J, e))
+
+
+def dls_by_method_object(J, e, damping):
+    return np.asarray(ik.DLS(damping=damping).step(J, e))  # runs dls_step_small on <= 3 rows
+
+
+def dls_by_method_table(J, e, damping):
+    return np.asarray(ik.core.methods.METHODS["dls"](damping=damping).step(J, e))
+
+
+class MyDLS(ik.DLS):  # a student's subclass of the method object
+    pass
+
+
+def priority_from_lecture_parts(J1, e1, J2, e2, damping):
+    N1 = np.asarray(ik.null_projector(J1))
+    first = np.asarray(ik.damped_pinv(J1, damping)) @ e1
+    return first + N1 @ (np.asarray(ik.damped_pinv(J2 @ N1, damping)) @ (e2 - J2 @ first))
+
+
+@pytest.mark.parametrize("number, functions, reference", [
+    (2, [jt_imported_inside], "ikteach.core.jt.jt_step"),
+    (2, [jt_by_getattr], "ikteach.core.jt.jt_step"),
+    (5, [lambda d, L, f: bool(ik.core.stop_rules.joint_steps(d) < f * np.sum(L)),
+         stop_rule_step], "ikteach.core.stop_rules.joint_steps"),  # an attribute chain
+    (4, [dls_by_method_object, dls_by_method_table], "ikteach.core.dls.dls_step_small"),
+    (4, [lambda J, e, d: np.asarray(MyDLS(damping=d).step(J, e)), ik.dls_step_normal],
+     "ikteach.core.dls.dls_step_small"),
+    (7, [priority_from_lecture_parts], "ikteach.core.priority.damped_pinv, "
+                                       "ikteach.core.priority.null_projector"),
+])
+def test_every_path_to_the_reference_is_refused_by_the_instant_check(number, functions,
+                                                                      reference):
+    """Function-level imports, getattr with a name, attribute chains, method objects, the
+    method table, a subclass, the lecture's parts of exercise 7: the grader's sandbox stubs
+    every one of them (test_reference_rule.py), so the instant check says 0 too."""
+    module = check.EXERCISES[number]
+    verdict = getattr(check, f"{module.CHECK_NAME}_verdict")(*functions)
+    assert verdict.score == 0 and reference in verdict.message, verdict.message
+
+
 def test_other_ikteach_functions_are_fine_in_the_instant_check():
     assert check.jacobian_verdict(planar_jacobian).passed  # ik.joint_positions: allowed
     other = check.pinv_step_verdict(lambda J, e, r: -np.asarray(ik.dls_step(J, e, 0.0)))

@@ -15,8 +15,9 @@ NUMBER = 3
 CHECK_NAME = "pinv_step"
 TITLE = "the pseudoinverse step"
 FUNCTIONS = ('pinv_step',)
-# ikteach's own answer to this exercise: absent from the grader's sandbox (grading/reference.py)
-REFERENCES = ("ikteach.core.pinv:pinv_step", "ikteach.core.pinv:pinv_two_rows")
+# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
+REFERENCES = ("ikteach.core.pinv:pinv_step", "ikteach.core.pinv:pinv_two_rows",
+              "ikteach.core.priority:damped_pinv")  # damping 0: J^+
 FIXED_CUTOFFS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5)  # relative cut-offs of a step ignoring rcond
 SWAP_HINT = ("\n  hint: J (m x n) = U Sigma V^T with U m x k and V n x k: U^T takes e (m entries) "
              "and V gives delta_theta (n entries), delta_theta = V Sigma^+ U^T e. U and V "

@@ -15,6 +15,7 @@ FUNCTIONS = ('dls_step', 'dls_step_normal')
 # ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
 REFERENCES = ("ikteach.core.dls:dls_step",
               "ikteach.core.dls:dls_step_normal",
+              "ikteach.core.dls:dls_step_small",  # what ik.DLS runs on 2-3 rows
               "ikteach.core.priority:damped_pinv",
 )
 

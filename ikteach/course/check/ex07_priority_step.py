@@ -18,6 +18,8 @@ FUNCTIONS = ("priority_step",)
 REFERENCES = ("ikteach.core.priority:priority_step",
               "ikteach.core.priority:multilevel_step",
               "ikteach.core.priority:null_space_step",
+              "ikteach.core.priority:damped_pinv",  # the parts the exercise asks for
+              "ikteach.core.priority:null_projector",
 )
 
 
