@@ -125,3 +125,35 @@ def test_a_wrong_answer_costs_the_same_on_every_draw(student, number, marks):
     namespace = notebook_functions(next((ROOT / "tests" / "submissions" / student).glob("*.ipynb")))
     for seed in (None,) + SEEDS + (7, 8, 9):
         assert check.grade(number, namespace, seed=seed).score == marks, seed
+
+
+def in_float32(fn):
+    """fn computed as written (float64), its arrays returned as float32; a returned step
+    function (exercise 5) returns float32 too."""
+    def wrapped(*args):
+        value = fn(*args)
+        if callable(value):
+            return in_float32(value)
+        if isinstance(value, (bool, np.bool_, dict)) or value is None:
+            return value
+        return np.asarray(value, dtype=np.float32)
+    return wrapped
+
+
+@pytest.mark.parametrize("number", [1, 2, 3, 4, 7])
+def test_a_float32_answer_gets_the_same_marks_under_every_seed(number):
+    """An honest answer returned as float32 (rounding 6e-8 of each entry): every tolerance is
+    relative to its case's scale, so the marks never depend on the hidden draw."""
+    namespace = solution(number)
+    rounded = {name: in_float32(namespace[name]) for name in check.EXERCISES[number].FUNCTIONS}
+    for seed in (None,) + tuple(range(40)):
+        verdict = check.grade(number, rounded, seed=seed)
+        assert verdict.score == 10, (seed, verdict.message)
+
+
+def test_a_float32_stop_rule_gets_the_same_marks_under_every_seed():
+    namespace = solution(5)
+    rounded = {"stalled": namespace["stalled"],
+               "stop_rule_step": in_float32(namespace["stop_rule_step"])}
+    for seed in (None, 1, 2, 3):
+        assert check.grade(5, rounded, seed=seed).score == 10, seed
