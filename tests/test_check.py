@@ -1,4 +1,6 @@
 """ik.check: the verdicts on right and wrong student functions (no kernels: direct calls)."""
+import re
+
 import numpy as np
 import pytest
 
@@ -150,8 +152,12 @@ def test_pinv_ignoring_rcond_loses_the_cutoff_points(seed, cutoff):
     every draw of the hidden cases."""
     verdict = check.pinv_step_verdict(pinv_fixed_cutoff(cutoff), seed=seed)
     assert verdict.score == 7 and not verdict.parts["small sigma dropped"], verdict.message
-    assert "ignores `rcond`: on every case it drops what a fixed relative cut-off of" \
-        in verdict.message, verdict.message  # (1e-2 and 1e-3 drop the same on some draws)
+    assert "ignores `rcond`: on every case it drops what a fixed relative cut-off" \
+        in verdict.message, verdict.message
+    said = verdict.message.split("fixed relative cut-off")[1].split(" drops;")[0]
+    low, high = (float(x) for x in re.findall(r"\d\.?\d*e-\d+|0\.\d+|\b1\b", said)[-2:]) \
+        if "between" in said else (float(said.split("of ")[1]),) * 2
+    assert low * 0.99 <= cutoff <= high * 1.01, (cutoff, said)  # the student's, not a neighbour
 
 
 def test_np_linalg_pinv_is_told_it_has_no_cutoff():
@@ -190,7 +196,31 @@ def test_dls_lambda_not_squared_and_partial_credit():
     verdict = check.ex04_dls_step.verdict(lam, ik.dls_step_normal)
     assert verdict.score == 4 and "missing square on lambda" in verdict.message
     assert "your two forms disagree" not in verdict.message  # the first failure is shown
-    assert verdict.parts == {"dls_step": False, "dls_step_normal": True, "agree": False}
+    assert verdict.parts == {"dls_step": False, "dls_step_normal": True, "both forms": False}
+
+
+def dls_m(J, e, damping):
+    return J.T @ np.linalg.solve(J @ J.T + damping**2 * np.eye(J.shape[0]), e)
+
+
+def dls_n(J, e, damping):
+    return np.linalg.solve(J.T @ J + damping**2 * np.eye(J.shape[1]), J.T @ e)
+
+
+@pytest.mark.parametrize("seed", [None, 1, 2])
+@pytest.mark.parametrize("forms, score, words", [
+    ((dls_m, dls_n), 10, "passed"),
+    ((dls_n, dls_n), 8, "`dls_step` is not J^T (J J^T + lambda^2 I)^-1 e, the m x m solve"),
+    ((dls_m, dls_m), 8, "`dls_step_normal` is not (J^T J + lambda^2 I)^-1 J^T e"),
+    ((lambda J, e, d: dls_m(J, e, 0.0), lambda J, e, d: dls_n(J, e, 0.0)), 0,
+     "the damping is missing"),
+    ((lambda J, e, d: np.linalg.pinv(J) @ e,) * 2, 2, "the damping is missing"),
+])
+def test_dls_forms_and_missing_damping_are_named(forms, score, words, seed):
+    """Both forms are checked as forms (at damping 0 only one of them is defined), and a step
+    without damping is told so, whatever its first failing case does (NaN, LinAlgError)."""
+    verdict = check.ex04_dls_step.verdict(*forms, seed=seed)
+    assert verdict.score == score and words in verdict.message, verdict.message
 
 
 def test_not_implemented_is_not_an_error(capsys):
