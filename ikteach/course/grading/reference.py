@@ -103,6 +103,8 @@ def sandbox_copy(package, dest, references=(), exercise=None, base=None):
 MIN_OPERATIONS = 20      # shorter functions (a one-line wrapper) are too common to report
 MAX_CODE_BYTES = 16384   # longer code cannot be a reference's (the longest is ~1 kB): skipped
 MAX_CODES = 400          # code objects compared per notebook (the rest are not)
+MAX_TOTAL_BYTES = 1 << 20  # compiled code read per notebook, in all
+MAX_NAMES = 300          # names of one function followed (the instant check, held_code)
 MAX_REACHED = 20000      # objects followed from a namespace or a student's functions
 
 
@@ -157,12 +159,13 @@ def _codes(code, limit=MAX_CODES):
 def fingerprints(codes):
     """{hash: function name} of every function in `codes` and nested in them (at least
     MIN_OPERATIONS long, at most MAX_CODES of them in all)."""
-    out, left = {}, MAX_CODES
+    out, left, budget = {}, MAX_CODES, MAX_TOTAL_BYTES
     for code in codes:
         for c in _codes(code, left):
             left -= 1
-            if c.co_name == "<module>" or len(c.co_code) > MAX_CODE_BYTES:
+            if c.co_name == "<module>" or len(c.co_code) > min(MAX_CODE_BYTES, budget):
                 continue
+            budget -= len(c.co_code)
             digest, count = fingerprint(c)
             if count >= MIN_OPERATIONS:
                 out[f"{digest}:{count}"] = c.co_name[:80]
@@ -233,16 +236,16 @@ def _named(fn):
     """What `fn`'s code names: the globals it loads, the modules it imports (at any level),
     and every attribute chain through them (`ik.core.stop_rules.joint_steps`); strings it
     holds count as names too (`getattr(ik, "jt_step")`, `import_module("ikteach.core.jt")`)."""
-    names, strings = set(), set()
-    for code in _codes(fn.__code__):
-        names.update(code.co_names)
-        strings.update(c for c in code.co_consts if isinstance(c, str) and len(c) < 200)
-    names |= strings
+    names = []
+    for code in _codes(fn.__code__, 50):
+        names += code.co_names
+        names += [c for c in code.co_consts if isinstance(c, str) and len(c) < 200]
+    names = list(dict.fromkeys(names))[:MAX_NAMES]
     found = [fn.__globals__.get(n) for n in names]
     modules = [v for v in found if isinstance(v, types.ModuleType)]
     modules += [sys.modules[n] for n in names if n in sys.modules]
     for module in modules:  # grows while it is read: the chains
-        if len(modules) > 200:
+        if len(modules) > 50:
             break
         try:
             attributes = vars(module)
