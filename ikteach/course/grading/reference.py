@@ -1,19 +1,26 @@
-"""The reference rule: what the grader guarantees about ikteach's own answers, and what it only
-reports.
+"""The reference rule (docs/lecturers.md, "The reference rule"): what the grader guarantees
+about ikteach's own answers, how the check cell applies the same rule, and what is only
+reported.
 
 Guaranteed (with bubblewrap): while exercise N is graded, every process of its sandbox (the
 fork server, the notebook's run, the checks' worker, anything they start) sees a COPY of
 ikteach (sandbox_copy) in which exercise N's reference functions (its check module's
 REFERENCES) have a body that raises ReferenceBlocked, and which holds no checker and no
 self-check answer. A reload, an exec of ikteach's source file, a fresh interpreter, a pickle
-by reference: all find the stub. The expected values are computed in the grader's own
-process, outside the sandbox; only the student's outputs come back.
+by reference, a method object that runs a reference: all find the stub. The expected values
+are computed in the grader's own process, outside the sandbox; only the student's outputs
+come back.
+
+The check cell (reached()): the references a student's functions reach through what their
+code names (globals, imports at any level, attribute chains, literal strings, defaults,
+closures, classes, containers, and ikteach's own functions on the way) give the same 0.
 
 Reported, not prevented: a notebook that carries ikteach's code in itself (its source typed or
 pasted in, a marshalled code object, an exec'd string). That is copying, which only a reader
-can judge; fingerprint() makes it visible: a code object's hash that ignores names,
-docstrings, file names and line numbers, compared with the references' and the self-check's
-(copied()). The grader writes what matched into grades.csv and the feedback.
+can judge; fingerprint() makes an exact copy visible: a code object's operations, names,
+docstrings, file names and line numbers ignored, compared with the references' (copied():
+what matched and how many operations). Reordered, rewritten or split code is not seen. The
+work is bounded whatever a file holds (MAX_CODES, MAX_CODE_BYTES, MAX_TOTAL_BYTES).
 """
 import ast
 import compileall
@@ -200,16 +207,14 @@ def _python_function(obj):
     return None
 
 
-def reference_fingerprints(references, extra_sources=()):
-    """{hash: what it is} of ikteach's reference functions and of answers given as source."""
+def reference_fingerprints(references):
+    """{hash: what it is} of ikteach's reference functions ("ikteach.core.x:fn")."""
     out = {}
     for ref in references:
         module, name = ref.split(":")
         fn = _python_function(getattr(importlib.import_module(module), name))
         if fn is not None:
             out.update({h: f"{module}.{name}" for h in fingerprints([fn.__code__])})
-    for label, source in extra_sources:
-        out.update({h: label for h in fingerprints([compile(source, label, "exec")])})
     return out
 
 
