@@ -116,6 +116,27 @@ def priority_step(J1, e1, J2, e2, damping):
     first = np.asarray(ik.damped_pinv(J1, damping)) @ e1
     return first + N1 @ (np.asarray(ik.damped_pinv(J2 @ N1, damping)) @ (e2 - J2 @ first))
 '''
+HONEST_JT = '''\
+def jt_step(J, e):
+    g = J.T @ e
+    v = J @ g
+    return np.zeros(J.shape[1]) if v @ v == 0 else (e @ v / (v @ v)) * g
+'''
+
+
+def fingerprint_stall():
+    """An honest jt_step beside 0.4 MB crafted against the copied report: deeply nested
+    lambdas, many functions, big constants (reference.py bounds the work on it)."""
+    nested = "_f{i} = " + "lambda x: x * 3 - x ** 2 + (" * 60 + "1" + ")" * 60 + "\n"
+    many = "def _g{i}(x):\n    return x * {i} + x ** 2 - abs(x) / 7 - max(x, {i}) * 3\n"
+    big = "_t{i} = " + repr(tuple(range(300))) + "\n"
+    parts, i = [HONEST_JT], 0
+    while sum(map(len, parts)) < 400_000:
+        parts += [nested.format(i=i), many.format(i=i), big.format(i=i)]
+        i += 1
+    return "".join(parts)
+
+
 LOOKUP = '''\
 _TABLE = {table!r}
 
@@ -167,6 +188,8 @@ SPELLINGS = [
     ("method_object", 4, METHOD_OBJECT, 0, "raised ReferenceBlocked: ikteach's dls_step_small",
      False),
     ("lecture_parts", 7, LECTURE_PARTS, 0, "`priority_step` raised ReferenceBlocked", False),
+    # the grader's own work on a student's file is bounded: graded as usual, nothing reported
+    ("fingerprint_stall", 2, None, 10, "passed, 10/10", False),
 ]
 FUNCTION = {1: "planar_jacobian", 2: "jt_step", 3: "pinv_step", 4: "dls_step", 5: "stalled",
             7: "priority_step"}
@@ -189,7 +212,8 @@ def graded(tmp_path_factory):
     base = tmp_path_factory.mktemp("reference-rule")
     subs = base / "submissions"
     shutil.copytree(SOLUTIONS, subs / "honest")
-    sources = {"marshal_blob": marshal_blob(), "typed_in": by_hand(), "lookup_table": lookup_table()}
+    sources = {"marshal_blob": marshal_blob(), "typed_in": by_hand(), "lookup_table": lookup_table(),
+               "fingerprint_stall": fingerprint_stall()}
     for student, number, source, *_ in SPELLINGS:
         write_student(subs, student, number, source or sources[student])
     out = base / "out" / "grades.csv"
