@@ -346,6 +346,8 @@ def priority_from_lecture_parts(J1, e1, J2, e2, damping):
     (4, [dls_by_method_object, dls_by_method_table], "ikteach.core.dls.dls_step_small"),
     (4, [lambda J, e, d: np.asarray(MyDLS(damping=d).step(J, e)), ik.dls_step_normal],
      "ikteach.core.dls.dls_step_small"),
+    (3, [lambda J, e, rcond: np.asarray(ik.damped_pinv(J, 0.0)) @ e],  # J^+ at damping 0
+     "ikteach.core.priority.damped_pinv"),
     (7, [priority_from_lecture_parts], "ikteach.core.priority.damped_pinv, "
                                        "ikteach.core.priority.null_projector"),
 ])
