@@ -11,8 +11,8 @@ from ...core.chain import planar_chain
 from ...core.dls import dls_step as _ref_dls
 from ...core.solve import StopSolve
 from ...core.solve import solve as _solve
-from .verdicts import (SOLVE_LIMIT, _Case, _Fail, _Part, _call, _check_callable, _evaluate,
-                       _fmt, _rng)
+from .verdicts import (SOLVE_LIMIT, _Case, _Fail, _Part, _as_array, _call, _check_callable,
+                       _close, _evaluate, _fmt, _rng)
 
 NUMBER = 5
 CHECK_NAME = "stop_rule"
@@ -193,7 +193,7 @@ def _stop_parts(stalled, stop_rule_step, seed=None):
                 return None  # said by the solve part
             stop = _stalled_reference(d, lengths, fraction)
             try:
-                got = _call(step, "the step function it returns", text, np.eye(len(d)), 2 * d)
+                got = _call(step, "the step stop_rule_step returns", text, np.eye(len(d)), 2 * d)
             except StopSolve:
                 if stop:
                     continue
@@ -207,13 +207,11 @@ def _stop_parts(stalled, stop_rule_step, seed=None):
                         f"\n  smallest failing case: {text}\n  threshold: "
                         f"{fraction * sum(lengths):.4g}, sum |delta_theta_i| = "
                         f"{np.abs(d).sum():.4g}: expected ik.StopSolve")
-            got = np.asarray(got, dtype=float) if got is not None else None
-            if got is None or got.shape != d.shape or not np.allclose(got, d, rtol=1e-6,
-                                                                      atol=1e-12):
+            got = _as_array(got, "the step stop_rule_step returns", text)
+            if not _close(got, d):
                 return (f"your step function must return the wrapped step's delta_theta "
                         f"unchanged when the rule does not fire.\n  smallest failing case: "
-                        f"{text}\n  expected: {_fmt(d)}\n  yours:    "
-                        f"{'None' if got is None else _fmt(got)}")
+                        f"{text}\n  expected: {_fmt(d)}\n  yours:    {_fmt(got)}")
 
     def solve_part():
         _check_callable(stop_rule_step, names[1])
