@@ -212,8 +212,8 @@ def graded(tmp_path_factory):
     base = tmp_path_factory.mktemp("reference-rule")
     subs = base / "submissions"
     shutil.copytree(SOLUTIONS, subs / "honest")
-    sources = {"marshal_blob": marshal_blob(), "typed_in": by_hand(), "lookup_table": lookup_table(),
-               "fingerprint_stall": fingerprint_stall()}
+    sources = {"marshal_blob": marshal_blob(), "typed_in": by_hand(),
+               "lookup_table": lookup_table(), "fingerprint_stall": fingerprint_stall()}
     for student, number, source, *_ in SPELLINGS:
         write_student(subs, student, number, source or sources[student])
     out = base / "out" / "grades.csv"
