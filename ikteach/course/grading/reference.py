@@ -248,7 +248,7 @@ def _named(fn):
     names = list(dict.fromkeys(names))[:MAX_NAMES]
     found = [fn.__globals__.get(n) for n in names]
     modules = [v for v in found if isinstance(v, types.ModuleType)]
-    modules += [sys.modules[n] for n in names if n in sys.modules]
+    modules += [m for m in map(sys.modules.get, names) if m is not None]  # imported, read only
     for module in modules:  # grows while it is read: the chains
         if len(modules) > 50:
             break
