@@ -11,6 +11,7 @@ from ...core.chain import planar_chain
 from ...core.dls import dls_step as _ref_dls
 from ...core.solve import StopSolve
 from ...core.solve import solve as _solve
+from ..grading.own_code import fixed_step
 from .verdicts import (SOLVE_LIMIT, _Case, _Fail, _Part, _as_array, _call, _check_callable,
                        _close, _evaluate, _fmt, _rng)
 
@@ -181,19 +182,20 @@ def _stop_parts(stalled, stop_rule_step, seed=None):
 
     def wrapper_on_the_rules_cases():
         """stop_rule_step(step, lengths, fraction) wrapping a step that returns delta_theta
-        (DLS with damping 1 on J = I, e = 2 delta_theta: exactly delta_theta): it must raise
-        ik.StopSolve on exactly the cases where the rule fires, and pass the step on
-        otherwise - whatever the arm of the solve below happens to do."""
+        (own_code.fixed_step): it must raise ik.StopSolve on exactly the cases where the rule
+        fires, and pass the step on otherwise - whatever the arm of the solve below does."""
         for case in _stop_cases(seed):
             d, lengths, fraction = case.args
             text = (f"stop_rule_step(step, lengths={_fmt(lengths)}, fraction={fraction:g}) with "
                     f"a step that returns delta_theta = {_fmt(d)}")
-            step = _call(stop_rule_step, names[1], text, _BASE_STEP, list(lengths), fraction)
+            given = functools.partial(fixed_step, delta=[float(x) for x in d])
+            step = _call(stop_rule_step, names[1], text, given, list(lengths), fraction)
             if not callable(step):
                 return None  # said by the solve part
             stop = _stalled_reference(d, lengths, fraction)
             try:
-                got = _call(step, "the step stop_rule_step returns", text, np.eye(len(d)), 2 * d)
+                got = _call(step, "the step stop_rule_step returns", text, np.eye(len(d)),
+                            d.copy())
             except StopSolve:
                 if stop:
                     continue
