@@ -1,4 +1,6 @@
 """ik.check: the verdicts on right and wrong student functions (no kernels: direct calls)."""
+import re
+
 import numpy as np
 import pytest
 
@@ -150,8 +152,12 @@ def test_pinv_ignoring_rcond_loses_the_cutoff_points(seed, cutoff):
     every draw of the hidden cases."""
     verdict = check.pinv_step_verdict(pinv_fixed_cutoff(cutoff), seed=seed)
     assert verdict.score == 7 and not verdict.parts["small sigma dropped"], verdict.message
-    assert "ignores `rcond`: on every case it drops what a fixed relative cut-off of" \
-        in verdict.message, verdict.message  # (1e-2 and 1e-3 drop the same on some draws)
+    assert "ignores `rcond`: on every case it drops what a fixed relative cut-off" \
+        in verdict.message, verdict.message
+    said = verdict.message.split("fixed relative cut-off")[1].split(" drops;")[0]
+    low, high = (float(x) for x in re.findall(r"\d\.?\d*e-\d+|0\.\d+|\b1\b", said)[-2:]) \
+        if "between" in said else (float(said.split("of ")[1]),) * 2
+    assert low * 0.99 <= cutoff <= high * 1.01, (cutoff, said)  # the student's, not a neighbour
 
 
 def test_np_linalg_pinv_is_told_it_has_no_cutoff():
@@ -190,7 +196,31 @@ def test_dls_lambda_not_squared_and_partial_credit():
     verdict = check.ex04_dls_step.verdict(lam, ik.dls_step_normal)
     assert verdict.score == 4 and "missing square on lambda" in verdict.message
     assert "your two forms disagree" not in verdict.message  # the first failure is shown
-    assert verdict.parts == {"dls_step": False, "dls_step_normal": True, "agree": False}
+    assert verdict.parts == {"dls_step": False, "dls_step_normal": True, "both forms": False}
+
+
+def dls_m(J, e, damping):
+    return J.T @ np.linalg.solve(J @ J.T + damping**2 * np.eye(J.shape[0]), e)
+
+
+def dls_n(J, e, damping):
+    return np.linalg.solve(J.T @ J + damping**2 * np.eye(J.shape[1]), J.T @ e)
+
+
+@pytest.mark.parametrize("seed", [None, 1, 2])
+@pytest.mark.parametrize("forms, score, words", [
+    ((dls_m, dls_n), 10, "passed"),
+    ((dls_n, dls_n), 8, "`dls_step` is not J^T (J J^T + lambda^2 I)^-1 e, the m x m solve"),
+    ((dls_m, dls_m), 8, "`dls_step_normal` is not (J^T J + lambda^2 I)^-1 J^T e"),
+    ((lambda J, e, d: dls_m(J, e, 0.0), lambda J, e, d: dls_n(J, e, 0.0)), 0,
+     "the damping is missing"),
+    ((lambda J, e, d: np.linalg.pinv(J) @ e,) * 2, 2, "the damping is missing"),
+])
+def test_dls_forms_and_missing_damping_are_named(forms, score, words, seed):
+    """Both forms are checked as forms (at damping 0 only one of them is defined), and a step
+    without damping is told so, whatever its first failing case does (NaN, LinAlgError)."""
+    verdict = check.ex04_dls_step.verdict(*forms, seed=seed)
+    assert verdict.score == score and words in verdict.message, verdict.message
 
 
 def test_not_implemented_is_not_an_error(capsys):
@@ -279,6 +309,56 @@ def test_a_wrapper_of_ikteachs_answer_is_told_what_the_grader_gives(number, func
     assert "raise ReferenceBlocked, so this gets 0/10 there" in verdict.message
     getattr(check, module.CHECK_NAME)(*functions)
     assert capsys.readouterr().out.strip() == verdict.message
+
+
+def jt_imported_inside(J, e):
+    from ikteach.core.jt import jt_step as step  # a function-level import
+    return np.asarray(step(J, e))
+
+
+def jt_by_getattr(J, e):
+    return np.asarray(getattr(ik, "jt_step")(J, e))
+
+
+def dls_by_method_object(J, e, damping):
+    return np.asarray(ik.DLS(damping=damping).step(J, e))  # runs dls_step_small on <= 3 rows
+
+
+def dls_by_method_table(J, e, damping):
+    return np.asarray(ik.core.methods.METHODS["dls"](damping=damping).step(J, e))
+
+
+class MyDLS(ik.DLS):  # a student's subclass of the method object
+    pass
+
+
+def priority_from_lecture_parts(J1, e1, J2, e2, damping):
+    N1 = np.asarray(ik.null_projector(J1))
+    first = np.asarray(ik.damped_pinv(J1, damping)) @ e1
+    return first + N1 @ (np.asarray(ik.damped_pinv(J2 @ N1, damping)) @ (e2 - J2 @ first))
+
+
+@pytest.mark.parametrize("number, functions, reference", [
+    (2, [jt_imported_inside], "ikteach.core.jt.jt_step"),
+    (2, [jt_by_getattr], "ikteach.core.jt.jt_step"),
+    (5, [lambda d, L, f: bool(ik.core.stop_rules.joint_steps(d) < f * np.sum(L)),
+         stop_rule_step], "ikteach.core.stop_rules.joint_steps"),  # an attribute chain
+    (4, [dls_by_method_object, dls_by_method_table], "ikteach.core.dls.dls_step_small"),
+    (4, [lambda J, e, d: np.asarray(MyDLS(damping=d).step(J, e)), ik.dls_step_normal],
+     "ikteach.core.dls.dls_step_small"),
+    (3, [lambda J, e, rcond: np.asarray(ik.damped_pinv(J, 0.0)) @ e],  # J^+ at damping 0
+     "ikteach.core.priority.damped_pinv"),
+    (7, [priority_from_lecture_parts], "ikteach.core.priority.damped_pinv, "
+                                       "ikteach.core.priority.null_projector"),
+])
+def test_every_path_to_the_reference_is_refused_by_the_instant_check(number, functions,
+                                                                      reference):
+    """Function-level imports, getattr with a name, attribute chains, method objects, the
+    method table, a subclass, the lecture's parts of exercise 7: the grader's sandbox stubs
+    every one of them (test_reference_rule.py), so the instant check says 0 too."""
+    module = check.EXERCISES[number]
+    verdict = getattr(check, f"{module.CHECK_NAME}_verdict")(*functions)
+    assert verdict.score == 0 and reference in verdict.message, verdict.message
 
 
 def test_other_ikteach_functions_are_fine_in_the_instant_check():

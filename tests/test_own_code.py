@@ -92,27 +92,88 @@ def known(number):
     return reference.reference_fingerprints(check.EXERCISES[number].REFERENCES)
 
 
-def test_a_copy_of_the_references_code_is_reported_a_students_own_is_not():
+def same_code(name, what, count):
+    return (f"`{name}` has the same code as {what}: all its {count} compiled operations in the "
+            "same order, names ignored (code written independently from the same formula can "
+            "match too: read both)")
+
+
+def operations(fn):
+    return reference.fingerprint(reference._python_function(fn).__code__)[1]
+
+
+TEXTBOOK_PINV = """\
+def pinv_step(J, e, rcond):
+    \"\"\"Golub & Van Loan: J+ e = sum over kept sigma_i of (u_i . e / sigma_i) v_i.\"\"\"
+    U, s, Vt = np.linalg.svd(J, full_matrices=False)
+    step = np.zeros(J.shape[1])
+    for i in range(len(s)):
+        if s[i] > 0 and s[i] >= rcond * s[0]:
+            step += (U[:, i] @ e) / s[i] * Vt[i]
+    return step
+"""
+
+
+def test_copied_code_is_reported_with_how_much_matched_and_what_is_not_seen():
+    """What the guide says (docs/lecturers.md): a copy with names changed is reported with the
+    number of operations that matched and the warning that independent code can match; a
+    textbook implementation written from the formula is not the same code; a copy with its
+    statements reordered (or rewritten, or split into helpers) is not seen."""
     import inspect
     from ikteach.core import pinv
     source = inspect.getsource(pinv.pinv_step.__wrapped__)
     renamed = (source.replace("pinv_step", "my_step").replace("sigma", "s").replace("jnp", "np")
                .replace('"""', '"""Mine. ', 1))
     found = reference.fingerprints([compile(renamed, "<cell 4>", "exec")])
+    count = operations(pinv.pinv_step)
     assert reference.copied(found, known(3)) == [
-        "`my_step` has the same code as ikteach.core.pinv.pinv_step"]
+        same_code("my_step", "ikteach.core.pinv.pinv_step", count)]
     blob = marshal.loads(marshal.dumps(pinv.pinv_step.__wrapped__.__code__))
     assert reference.copied(reference.fingerprints([blob]), known(3))
+    textbook = reference.fingerprints([compile(TEXTBOOK_PINV, "<cell 3>", "exec")])
+    assert reference.copied(textbook, known(3)) == []
+    lines = renamed.splitlines()
+    keep = next(i for i, line in enumerate(lines) if "keep = " in line)
+    lines[keep], lines[keep - 1] = lines[keep - 1], lines[keep]  # two statements swapped
+    reordered = "\n".join(lines).replace("keep = s >= rcond * s[0]", "keep = rcond * s[0] <= s")
+    assert reordered != renamed
+    found = reference.fingerprints([compile(reordered, "<cell 4>", "exec")])
+    assert reference.copied(found, known(3)) == []  # the guide: reordering is not seen
     good = reference.fingerprints([compile(selfcheck.GOOD, "<cell 2>", "exec")])
     assert reference.copied(good, known(2)) == [  # the self-check's answer: ikteach's own
-        "`jt_step` has the same code as ikteach.core.jt.jt_step",
-        "`optimal_alpha` has the same code as ikteach.core.jt.optimal_alpha"]
+        same_code("jt_step", "ikteach.core.jt.jt_step", operations(ik_jt().jt_step)),
+        same_code("optimal_alpha", "ikteach.core.jt.optimal_alpha",
+                  operations(ik_jt().optimal_alpha))]
     for number in sorted(check.EXERCISES):  # the instructor's solutions: their own code
         path = next((ROOT / "instructor" / "solutions").glob(f"{number:02d}_*.ipynb"))
         cells = code_cells(json.loads(path.read_text()))
         found = reference.fingerprints([compile(python_source(c), f"<cell {n}>", "exec")
                                         for n, c in cells])
         assert reference.copied(found, known(number)) == [], number
+
+
+def ik_jt():
+    from ikteach.core import jt
+    return jt
+
+
+def test_fingerprints_are_bounded_whatever_the_cell():
+    """A cell crafted against the fingerprint (deeply nested lambdas, huge constants, very
+    many functions) costs bounded work: each code object is read once, at most MAX_CODES of
+    them, long ones skipped, constants shown only when small; cells over the size bound are
+    not compiled at all."""
+    nested = "f = " + "lambda: (" * 150 + "1" + ")" * 150 + "\n"
+    many = "".join(f"def g{i}(x):\n    return x * {i} + x ** 2 - (x, {i})[0] + abs(x) / 7"
+                   f" - max(x, {i}) * 3\n" for i in range(2000))
+    huge = "def h():\n    return " + repr(tuple(range(5000))) + " + (" + "10**400" + ",)\n"
+    code = compile(nested + many + huge, "<cell 1>", "exec")
+    seen = list(reference._codes(code))
+    assert len(seen) == reference.MAX_CODES
+    found = reference.fingerprints([code])
+    assert 0 < len(found) <= reference.MAX_CODES
+    assert all(len(k) <= 64 and len(v) <= 80 for k, v in found.items())  # what the worker sends
+    assert reference.source_fingerprints([(1, nested + many)], max_chars=1000) == {}
+    assert reference.source_fingerprints([(1, "def ok(:\n")]) == {}  # not Python: skipped
 
 
 def test_the_worker_reports_code_its_namespace_holds():
@@ -128,7 +189,7 @@ def test_the_worker_reports_code_its_namespace_holds():
         """), "<cell 3>", "exec"), namespace)
     held = reference.fingerprints(reference.held_code(namespace))
     assert reference.copied(held, known(3)) == [
-        "`pinv_step` has the same code as ikteach.core.pinv.pinv_step"]
+        same_code("pinv_step", "ikteach.core.pinv.pinv_step", operations(pinv.pinv_step))]
 
 
 DEFINITIONS = [

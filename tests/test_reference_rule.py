@@ -83,6 +83,60 @@ _f = types.FunctionType(marshal.loads(base64.b64decode("{blob}")), {{"jnp": jnp}
 def pinv_step(J, e, rcond):
     return np.asarray(_f(J, e, rcond))
 '''
+IMPORT_INSIDE = '''\
+def jt_step(J, e):
+    from ikteach.core.jt import jt_step as step
+    return np.asarray(step(J, e))
+'''
+ATTRIBUTE_CHAIN = '''\
+def stalled(delta_theta, lengths, fraction):
+    return bool(ik.core.stop_rules.joint_steps(np.asarray(delta_theta)) < fraction * sum(lengths))
+
+
+def stop_rule_step(step, lengths, fraction):
+    def wrapped(J, e):
+        delta = np.asarray(step(J, e))
+        if stalled(delta, lengths, fraction):
+            raise ik.StopSolve("stalled")
+        return delta
+    return wrapped
+'''
+METHOD_OBJECT = '''\
+def dls_step(J, e, damping):
+    return np.asarray(ik.DLS(damping=damping).step(np.asarray(J), np.asarray(e)))
+
+
+def dls_step_normal(J, e, damping):
+    method = ik.core.methods.METHODS["dls"](damping=damping)
+    return np.asarray(method.step(np.asarray(J), np.asarray(e)))
+'''
+LECTURE_PARTS = '''\
+def priority_step(J1, e1, J2, e2, damping):
+    N1 = np.asarray(ik.null_projector(J1))
+    first = np.asarray(ik.damped_pinv(J1, damping)) @ e1
+    return first + N1 @ (np.asarray(ik.damped_pinv(J2 @ N1, damping)) @ (e2 - J2 @ first))
+'''
+HONEST_JT = '''\
+def jt_step(J, e):
+    g = J.T @ e
+    v = J @ g
+    return np.zeros(J.shape[1]) if v @ v == 0 else (e @ v / (v @ v)) * g
+'''
+
+
+def fingerprint_stall():
+    """An honest jt_step beside 0.4 MB crafted against the copied report: deeply nested
+    lambdas, many functions, big constants (reference.py bounds the work on it)."""
+    nested = "_f{i} = " + "lambda x: x * 3 - x ** 2 + (" * 60 + "1" + ")" * 60 + "\n"
+    many = "def _g{i}(x):\n    return x * {i} + x ** 2 - abs(x) / 7 - max(x, {i}) * 3\n"
+    big = "_t{i} = " + repr(tuple(range(300))) + "\n"
+    parts, i = [HONEST_JT], 0
+    while sum(map(len, parts)) < 400_000:
+        parts += [nested.format(i=i), many.format(i=i), big.format(i=i)]
+        i += 1
+    return "".join(parts)
+
+
 LOOKUP = '''\
 _TABLE = {table!r}
 
@@ -128,8 +182,18 @@ SPELLINGS = [
     ("typed_in", 3, None, 10, "`pinv_step` has the same code as ikteach.core.pinv.pinv_step",
      True),
     ("lookup_table", 1, None, 2, "lever arms x", False),
+    # the paths the instant check follows too (test_instant_check_agrees)
+    ("import_inside", 2, IMPORT_INSIDE, 0, "`jt_step` raised ReferenceBlocked", False),
+    ("attribute_chain", 5, ATTRIBUTE_CHAIN, 0, "`stalled` raised ReferenceBlocked", False),
+    ("method_object", 4, METHOD_OBJECT, 0, "raised ReferenceBlocked: ikteach's dls_step_small",
+     False),
+    ("lecture_parts", 7, LECTURE_PARTS, 0, "`priority_step` raised ReferenceBlocked", False),
+    # the grader's own work on a student's file is bounded: graded as usual, nothing reported
+    ("fingerprint_stall", 2, None, 10, "passed, 10/10", False),
 ]
-FUNCTION = {1: "planar_jacobian", 2: "jt_step", 3: "pinv_step", 7: "priority_step"}
+FUNCTION = {1: "planar_jacobian", 2: "jt_step", 3: "pinv_step", 4: "dls_step", 5: "stalled",
+            7: "priority_step"}
+AGREE = ("import_inside", "attribute_chain", "method_object", "lecture_parts")
 
 
 def write_student(subs, student, number, source):
@@ -148,7 +212,8 @@ def graded(tmp_path_factory):
     base = tmp_path_factory.mktemp("reference-rule")
     subs = base / "submissions"
     shutil.copytree(SOLUTIONS, subs / "honest")
-    sources = {"marshal_blob": marshal_blob(), "typed_in": by_hand(), "lookup_table": lookup_table()}
+    sources = {"marshal_blob": marshal_blob(), "typed_in": by_hand(),
+               "lookup_table": lookup_table(), "fingerprint_stall": fingerprint_stall()}
     for student, number, source, *_ in SPELLINGS:
         write_student(subs, student, number, source or sources[student])
     out = base / "out" / "grades.csv"
@@ -186,3 +251,17 @@ def test_each_spelling_of_ikteachs_answer(graded, student, number, source, marks
 def test_the_log_records_the_hidden_cases_seed(graded):
     _, _, log = graded
     assert "hidden cases: seed " in log and "--seed " in log
+
+
+@pytest.mark.parametrize("student", AGREE)
+def test_instant_check_agrees(graded, student):
+    """The check cell gives what the grader gave: 0, naming ikteach's function (issue 40)."""
+    rows, _, _ = graded
+    number, source = next((n, src) for name, n, src, *_ in SPELLINGS if name == student)
+    namespace = {"np": np, "ik": __import__("ikteach")}
+    exec(compile(source, "<cell 3>", "exec"), namespace)
+    module = check.EXERCISES[number]
+    verdict = getattr(check, f"{module.CHECK_NAME}_verdict")(
+        *(namespace[n] for n in module.FUNCTIONS))
+    assert verdict.score == float(rows[student][f"ex{number}"]) == 0, verdict.message
+    assert "calls ikteach's own answer to this exercise" in verdict.message

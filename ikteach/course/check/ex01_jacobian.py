@@ -25,9 +25,11 @@ REFERENCES = ("ikteach.core.jacobian:jacobian",
 )
 
 
-HAND = [([1.0], [0.0], "regular"), ([1.0, 1.0], [0.0, 0.0], "singular"),
-        ([1.0, 1.0], [0.0, np.pi], "singular"), ([1.0, 2.0], [0.3, 0.5], "regular"),
-        ([1.0, 1.0, 1.0], [0.0, 0.0, 0.0], "singular")]
+# the singular arms point off the x axis (base angle != 0): lying along x, row 0 of J is zero
+# there and a slip in row 0 alone would pass them (the hidden cases draw the base angle)
+HAND = [([1.0], [0.0], "regular"), ([1.0, 1.0], [0.5, 0.0], "singular"),
+        ([1.0, 1.0], [-0.4, np.pi], "singular"), ([1.0, 2.0], [0.3, 0.5], "regular"),
+        ([1.0, 1.0, 1.0], [1.2, 0.0, 0.0], "singular")]
 
 
 def _hidden_hand(rng):
@@ -68,6 +70,11 @@ def _diagnose_jacobian(got, want, case):
         return ("wrong sign: your Jacobian is -1 x the expected one. Column i is "
                 "z_i x (p_e - p_i) = z x (p_e - p_i) = (-(y_e - y_i), x_e - x_i)."
                 + _mismatch(got, want, case, "J"))
+    for row, other, what in ((0, 1, "row 0 (x) is -(y_e - y_i)"), (1, 0, "row 1 (y) is x_e - x_i")):
+        if _close(got[row], -want[row], scale=np.abs(want).max()) and _close(
+                got[other], want[other], scale=np.abs(want).max()):
+            return (f"row {row} has the wrong sign (the other row is right): z x (p_e - p_i) = "
+                    f"(-(y_e - y_i), x_e - x_i), so {what}." + _mismatch(got, want, case, "J"))
     if _close(got, want[:, ::-1]):
         return ("the columns are in reverse order: column i belongs to joint i (J[:, 0] is "
                 "joint 1, at the base)." + _mismatch(got, want, case, "J"))

@@ -73,7 +73,7 @@ def _jt_parts(fn, name, seed=None):
         if not np.all(np.isfinite(got)):
             raise _Fail(f"your step contains NaN or inf.{_mismatch(got, _ref(case), case)}")
         c = float(got @ g / (g @ g))
-        return c, np.allclose(got, c * g, rtol=1e-6, atol=1e-9)
+        return c, _close(got, c * g)
 
     def _ref(case):
         return np.asarray(_ref_jt(*case.args))

@@ -15,9 +15,10 @@ NUMBER = 3
 CHECK_NAME = "pinv_step"
 TITLE = "the pseudoinverse step"
 FUNCTIONS = ('pinv_step',)
-# ikteach's own answer to this exercise: absent from the grader's sandbox (grading/reference.py)
-REFERENCES = ("ikteach.core.pinv:pinv_step", "ikteach.core.pinv:pinv_two_rows")
-FIXED_CUTOFFS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5)  # relative cut-offs of a step ignoring rcond
+# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
+REFERENCES = ("ikteach.core.pinv:pinv_step", "ikteach.core.pinv:pinv_two_rows",
+              "ikteach.core.priority:damped_pinv")  # damping 0: J^+
+FIXED_CUTOFFS = tuple(10.0 ** (-k / 4) for k in range(33))  # a step ignoring rcond
 SWAP_HINT = ("\n  hint: J (m x n) = U Sigma V^T with U m x k and V n x k: U^T takes e (m entries) "
              "and V gives delta_theta (n entries), delta_theta = V Sigma^+ U^T e. U and V "
              "swapped? (np.linalg.svd returns U, sigma and V^T.)")
@@ -100,13 +101,21 @@ def _relative(rcond):
 
 
 def _fixed_cutoff(results):
-    """The fixed relative cut-off that gives the student's step on every case of `results`
-    ([(case, got)]) when the rcond passed in does not, or None."""
-    for c in FIXED_CUTOFFS:
-        if all(_close(np.abs(got), np.abs(_pinv_variant(*case.args[:2], _relative(c))))
-               for case, got in results):
-            return c
-    return None
+    """(low, high): the fixed relative cut-offs (a grid from 1 to 1e-8, 4 per decade) that
+    give the student's step on every case of `results` ([(case, got)]), or None. The cases
+    cannot tell apart cut-offs between two of their singular value ratios: the message names
+    the whole range, not one value of it."""
+    fits = [c for c in FIXED_CUTOFFS
+            if all(_close(np.abs(got), np.abs(_pinv_variant(*case.args[:2], _relative(c))))
+                   for case, got in results)]
+    return (min(fits), max(fits)) if fits else None
+
+
+def _cutoff_text(fits):
+    low, high = fits
+    if low == high:
+        return f"a fixed relative cut-off of {low:.2g}"
+    return f"a fixed relative cut-off (any between {low:.2g} and {high:.2g} fits these cases)"
 
 
 def _diagnose(got, want, case):
@@ -168,10 +177,10 @@ def _pinv_parts(fn, name, seed=None):
                 return ("the cut-off must be relative: drop sigma_i < rcond * sigma_max "
                         "(the largest singular value), not sigma_i < rcond."
                         + _mismatch(got, want, case))
-            fixed = _fixed_cutoff(results)
-            if tag == "cutoff" and fixed is not None:
-                return (f"your cut-off ignores `rcond`: on every case it drops what a fixed "
-                        f"relative cut-off of {fixed:g} drops; here rcond = {rcond:g}. Drop "
+            fixed = _fixed_cutoff(results) if tag == "cutoff" else None
+            if fixed is not None:
+                return (f"your cut-off ignores `rcond`: on every case it drops what "
+                        f"{_cutoff_text(fixed)} drops; here rcond = {rcond:g}. Drop "
                         "sigma_i < rcond * sigma_max with the rcond passed in."
                         + _mismatch(got, want, case))
             if tag == "zero":

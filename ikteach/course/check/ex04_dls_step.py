@@ -1,12 +1,14 @@
 """Exercise 4: both DLS forms against ik.dls_step, and against each other.
 
-Parts: each form 4, the two forms agree 2.
+Parts: each form 4; both forms 2 (they agree, and each is its own form: at damping 0 the m x m
+form is defined for a wide J, the n x n form for a tall one, where the other is singular).
 """
 import numpy as np
 
 from ...core.dls import dls_step as _ref_dls
-from .verdicts import (_Case, _Part, _as_array, _call, _check_callable, _close, _evaluate,
-                       _fmt, _matrix_text, _mismatch, _rng, _shape_message)
+from .verdicts import (_Case, _Fail, _Part, _as_array, _call, _check_callable, _close,
+                       _evaluate, _fmt, _matrix_text, _mismatch, _random_matrix, _rng,
+                       _shape_message)
 
 NUMBER = 4
 CHECK_NAME = "dls_step"
@@ -15,6 +17,7 @@ FUNCTIONS = ('dls_step', 'dls_step_normal')
 # ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
 REFERENCES = ("ikteach.core.dls:dls_step",
               "ikteach.core.dls:dls_step_normal",
+              "ikteach.core.dls:dls_step_small",  # what ik.DLS runs on 2-3 rows
               "ikteach.core.priority:damped_pinv",
 )
 
@@ -51,6 +54,25 @@ def _dls_cases(seed=None):
     return sorted(cases, key=lambda c: c.size)
 
 
+def _form_cases(seed=None):
+    """Damping 0, where only one form is defined: a wide J of full row rank (J J^T invertible,
+    the n x n J^T J singular) for the m x m form, a tall J of full column rank for the n x n
+    form. Each is then J^+ e."""
+    rng = _rng(seed, 40)
+    wide, tall = _random_matrix(rng, 2, 4).round(3), _random_matrix(rng, 4, 2).round(3)
+    return [_Case((wide, rng.normal(size=2).round(3), 0.0),
+                  _matrix_text(wide, np.zeros(2)).split(", e =")[0] + " (wide, full row rank)"),
+            _Case((tall, rng.normal(size=4).round(3), 0.0),
+                  _matrix_text(tall, np.zeros(4)).split(", e =")[0] + " (tall, full column rank)")]
+
+
+NO_DAMPING = ("the damping is missing: your step is the undamped J^+ e (the least-squares step, "
+              "which blows up near a singularity). Damped least squares adds lambda^2 I: "
+              "J^T (J J^T + lambda^2 I)^-1 e.")
+FORMS = ("J^T (J J^T + lambda^2 I)^-1 e, the m x m solve", "(J^T J + lambda^2 I)^-1 J^T e, "
+         "the n x n solve")
+
+
 def _dls_parts(fns, names, seed=None):
     cases = _dls_cases(seed)
     cache = {}
@@ -63,46 +85,92 @@ def _dls_parts(fns, names, seed=None):
             cache[key] = _as_array(got, names[which], case)
         return cache[key]
 
+    def undamped(which):
+        """Is the answer the undamped J^+ e wherever the undamped form is defined (J of full
+        row rank for the m x m form, of full column rank for the n x n one), on cases where
+        damping matters?"""
+        found = [(case, cache[(which, id(case))]) for case in cases if (which, id(case)) in cache
+                 and np.linalg.matrix_rank(case.args[0]) == case.args[0].shape[which]]
+        plain = [np.linalg.pinv(c.args[0]) @ c.args[1] for c, _ in found]
+        return bool(found) and all(_close(g, p) for (_, g), p in zip(found, plain)) and any(
+            not _close(p, np.asarray(_ref_dls(*c.args))) for (c, _), p in zip(found, plain))
+
+    def diagnose(which, got, want, case):
+        name = names[which]
+        if not np.all(np.isfinite(got)):
+            return ("NaN or inf near a singularity: with damping > 0, J J^T + "
+                    "lambda^2 I is always invertible - no pseudoinverse needed."
+                    + _mismatch(got, want, case))
+        if _close(got, np.asarray(_ref_dls(*case.args[:2], np.sqrt(case.args[2])))):
+            return (f"missing square on lambda: `{name}` adds lambda I, the damping "
+                    "term is lambda^2 I (from lambda^2 |delta_theta|^2)."
+                    + _mismatch(got, want, case))
+        if _close(got, -want):
+            return "wrong sign." + _mismatch(got, want, case)
+        return f"wrong values: `{name}` should compute {FORMS[which]}." + _mismatch(
+            got, want, case)
+
     def form(which):
         name = names[which]
 
         def check():
             _check_callable(fns[which], name)
+            first = None  # (case, got or None, error or None): the smallest failing case
             for case in cases:
-                J, e, lam = case.args
-                got, want = result(which, case), np.asarray(_ref_dls(J, e, lam))
+                try:
+                    got = result(which, case)
+                except _Fail as exc:
+                    if type(exc) is not _Fail:
+                        raise
+                    first = first or (case, None, str(exc))
+                    continue
+                want = np.asarray(_ref_dls(*case.args))
                 if got.shape != want.shape:
                     return _shape_message(name, got, want, case, " - one entry per joint")
-                if _close(got, want):
-                    continue
-                if not np.all(np.isfinite(got)):
-                    return ("NaN or inf near a singularity: with damping > 0, J J^T + "
-                            "lambda^2 I is always invertible - no pseudoinverse needed."
-                            + _mismatch(got, want, case))
-                if _close(got, np.asarray(_ref_dls(J, e, np.sqrt(lam)))):
-                    return (f"missing square on lambda: `{name}` adds lambda I, the damping "
-                            "term is lambda^2 I (from lambda^2 |delta_theta|^2)."
-                            + _mismatch(got, want, case))
-                if _close(got, -want):
-                    return "wrong sign." + _mismatch(got, want, case)
-                formula = ("J^T (J J^T + lambda^2 I)^-1 e" if which == 0
-                           else "(J^T J + lambda^2 I)^-1 J^T e")
-                return f"wrong values: `{name}` should compute {formula}." + _mismatch(
-                    got, want, case)
+                if not _close(got, want):
+                    first = first or (case, got, None)
+            if first is None:
+                return None
+            if undamped(which):
+                case, got, error = first
+                return NO_DAMPING + (f"\n  smallest failing case: {case}\n  {error}" if error
+                                     else _mismatch(got, np.asarray(_ref_dls(*case.args)), case))
+            case, got, error = first
+            if error is not None:
+                raise _Fail(error)
+            return diagnose(which, got, np.asarray(_ref_dls(*case.args)), case)
         return check
 
-    def agree():
+    def both_forms():
+        """The two agree, and each is its own form: at damping 0 only that form is defined."""
         for which in (0, 1):
             _check_callable(fns[which], names[which])
         for case in cases:
             a, b = result(0, case), result(1, case)
-            if a.shape != b.shape or not _close(a, b, rtol=1e-6, atol=1e-9):
+            if a.shape != b.shape or not _close(a, b):
                 return (f"your two forms disagree: `{names[0]}` and `{names[1]}` should give the "
                         "same step, (J^T J + lambda^2 I)^-1 J^T = J^T (J J^T + lambda^2 I)^-1."
                         f"\n  smallest failing case: {case}\n  {names[0]}: {_fmt(a)}"
                         f"\n  {names[1]}: {_fmt(b)}")
+        for which, case in enumerate(_form_cases(seed)):
+            J, e, _ = case.args
+            want, other = np.linalg.pinv(J) @ e, ("J^T J", "J J^T")[which]
+            try:
+                got = _as_array(_call(fns[which], names[which], case, J.copy(), e.copy(), 0.0),
+                                names[which], case)
+                problem = None if _close(got, want) else f"your result: {_fmt(got)}"
+            except _Fail as exc:
+                if type(exc) is not _Fail:
+                    raise
+                problem = str(exc).split(" on J = ")[0]
+            if problem is not None:
+                return (f"`{names[which]}` is not {FORMS[which]}: at damping = 0 with {case}, "
+                        f"that form is defined (J^+ e = {_fmt(want)}) while {other} is "
+                        f"singular. {problem}. The same form written twice? Write each form "
+                        "as the exercise asks.")
 
-    return [_Part(names[0], 4, form(0)), _Part(names[1], 4, form(1)), _Part("agree", 2, agree)]
+    return [_Part(names[0], 4, form(0)), _Part(names[1], 4, form(1)),
+            _Part("both forms", 2, both_forms)]
 
 
 def verdict(dls_step, dls_step_normal, seed=None):

@@ -1,6 +1,7 @@
 """Exercise 5: stalled(delta_theta, lengths, fraction) and stop_rule_step(step, lengths, fraction).
 
-Parts: the rule 5, the rule ending ik.solve (through ik.StopSolve) 5.
+Parts: the rule 5; the rule ending ik.solve 5 (the returned step function raises ik.StopSolve on
+exactly the rule's cases, then ends an out-of-reach ik.solve "stalled" where the rule says).
 """
 import functools
 
@@ -10,8 +11,9 @@ from ...core.chain import planar_chain
 from ...core.dls import dls_step as _ref_dls
 from ...core.solve import StopSolve
 from ...core.solve import solve as _solve
-from .verdicts import (SOLVE_LIMIT, _Case, _Fail, _Part, _call, _check_callable, _evaluate,
-                       _fmt, _rng)
+from ..grading.own_code import fixed_step
+from .verdicts import (SOLVE_LIMIT, _Case, _Fail, _Part, _as_array, _call, _check_callable,
+                       _close, _evaluate, _fmt, _rng)
 
 NUMBER = 5
 CHECK_NAME = "stop_rule"
@@ -59,6 +61,9 @@ _RULE_MISTAKES = [  # (a wrong rule, what to say), tried in this order against e
     (lambda d, L, f: float(np.sum(np.abs(d))) < f * float(np.max(L)),
      "the threshold is fraction * (sum of the lengths), the whole arm's length - not the "
      "longest link."),
+    (lambda d, L, f: float(np.linalg.norm(d)) < f * _total(L),
+     "sum the joint steps (sum |delta_theta_i|), not their 2-norm (the length of "
+     "delta_theta): the report's rule is the sum of the absolute steps."),
     (lambda d, L, f: float(np.max(np.abs(d))) < f * _total(L),
      "sum the joint steps (sum |delta_theta_i|), not their largest."),
     (lambda d, L, f: not _stalled_reference(d, L, f),
@@ -71,13 +76,15 @@ HAND = [([0.1, -0.1], [1.0, 1.0], 1e-3), ([2e-3, 0.0, 0.0], [1.0, 1.0, 1.0], 1e-
         ([1e-3, 1e-3, 1e-3], [1.0, 1.0, 1.0], 1e-3), ([0.05, 0.05], [10.0, 20.0], 1e-3),
         ([-1e-3, 5e-4], [2.0, 1.0], 1e-3), ([0.5], [1.0], 1e-3),
         ([5e-4, 5e-4], [0.5, 0.5], 1e-3),  # exactly at the threshold
-        ([6e-4, 6e-4], [0.5, 0.5], 1e-3)]  # each joint below it, their sum above
+        ([6e-4, 6e-4], [0.5, 0.5], 1e-3),  # each joint below it, their sum above
+        ([8e-4, 8e-4], [0.5, 0.5], 1e-3)]  # each joint below it, their 2-norm above
 
 
 def _hidden_hand(rng):
     """HAND's kinds with other numbers: opposite steps that cancel, one joint at twice the
     threshold, every joint at a third of it, long links, mixed signs, one link, exactly at the
-    threshold (binary fractions: the sums are exact), each joint below it but the sum above."""
+    threshold (binary fractions: the sums are exact), each joint below it but the sum above,
+    each joint below it but the 2-norm above."""
     f = float(rng.choice([1e-3, 1e-2]))
     a = float(rng.choice([1, 2, 3, 5, 6, 7])) / 8  # k/8: a * f * 2 is exactly f * (a + a)
     L2, L3 = (rng.uniform(0.5, 2.0, n).round(3).tolist() for n in (2, 3))
@@ -87,7 +94,8 @@ def _hidden_hand(rng):
             ([2 * t3, 0.0, 0.0], L3, f), ([t3 / 3] * 3, L3, f),
             ([0.05, 0.05], rng.uniform(5.0, 30.0, 2).round(1).tolist(), f),
             ([-t2 / 2, t2 / 4], L2, f), ([x * 5], [float(rng.uniform(0.5, 2.0))], f),
-            ([f * a, f * a], [a, a], f), ([0.6 * f * a * 2, 0.6 * f * a * 2], [a, a], f)]
+            ([f * a, f * a], [a, a], f), ([0.6 * f * a * 2, 0.6 * f * a * 2], [a, a], f),
+            ([0.8 * f * a * 2, 0.8 * f * a * 2], [a, a], f)]
 
 
 def _stop_cases(seed=None):
@@ -172,8 +180,46 @@ def _stop_parts(stalled, stop_rule_step, seed=None):
         except _Fail as exc:
             raise type(exc)(str(exc).replace(f" on {case}", f" inside {case}")) from None
 
+    def wrapper_on_the_rules_cases():
+        """stop_rule_step(step, lengths, fraction) wrapping a step that returns delta_theta
+        (own_code.fixed_step): it must raise ik.StopSolve on exactly the cases where the rule
+        fires, and pass the step on otherwise - whatever the arm of the solve below does."""
+        for case in _stop_cases(seed):
+            d, lengths, fraction = case.args
+            text = (f"stop_rule_step(step, lengths={_fmt(lengths)}, fraction={fraction:g}) with "
+                    f"a step that returns delta_theta = {_fmt(d)}")
+            given = functools.partial(fixed_step, delta=[float(x) for x in d])
+            step = _call(stop_rule_step, names[1], text, given, list(lengths), fraction)
+            if not callable(step):
+                return None  # said by the solve part
+            stop = _stalled_reference(d, lengths, fraction)
+            try:
+                got = _call(step, "the step stop_rule_step returns", text, np.eye(len(d)),
+                            d.copy())
+            except StopSolve:
+                if stop:
+                    continue
+                return (f"your step function raised ik.StopSolve where the rule does not fire."
+                        f"\n  smallest failing case: {text}\n  threshold: "
+                        f"{fraction * sum(lengths):.4g}, sum |delta_theta_i| = "
+                        f"{np.abs(d).sum():.4g}: the step must go on")
+            if stop:
+                return ("the solve never stopped: when the rule fires, raise ik.StopSolve from "
+                        "your step function (ik.solve then ends \"stalled\")."
+                        f"\n  smallest failing case: {text}\n  threshold: "
+                        f"{fraction * sum(lengths):.4g}, sum |delta_theta_i| = "
+                        f"{np.abs(d).sum():.4g}: expected ik.StopSolve")
+            got = _as_array(got, "the step stop_rule_step returns", text)
+            if not _close(got, d):
+                return (f"your step function must return the wrapped step's delta_theta "
+                        f"unchanged when the rule does not fire.\n  smallest failing case: "
+                        f"{text}\n  expected: {_fmt(d)}\n  yours:    {_fmt(got)}")
+
     def solve_part():
         _check_callable(stop_rule_step, names[1])
+        problem = wrapper_on_the_rules_cases()
+        if problem is not None:
+            return problem
         case = (f"stop_rule_step(step, lengths={arm_lengths}, fraction={STOP_FRACTION:g}) "
                 f"with step = DLS (damping {STOP_DAMPING:g})")
         step = _call(stop_rule_step, names[1], case, _BASE_STEP, list(arm_lengths),

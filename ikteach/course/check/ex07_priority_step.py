@@ -18,6 +18,8 @@ FUNCTIONS = ("priority_step",)
 REFERENCES = ("ikteach.core.priority:priority_step",
               "ikteach.core.priority:multilevel_step",
               "ikteach.core.priority:null_space_step",
+              "ikteach.core.priority:damped_pinv",  # the parts the exercise asks for
+              "ikteach.core.priority:null_projector",
 )
 
 
@@ -90,9 +92,13 @@ def _priority_variants(J1, e1, J2, e2, lam):
 def _primary_kept(got, J1, e1, lam):
     """J1 delta = J1 J1+ e1 (J1+ damped with lambda^2, or lambda: that slip is another part's):
     the secondary task moves nothing the primary sees."""
-    return (got.shape == (J1.shape[1],) and bool(np.all(np.isfinite(got)))
-            and any(np.allclose(J1 @ got, J1 @ first, rtol=1e-6, atol=1e-8)
-                    for first in _first_steps(J1, e1, lam)))
+    if got.shape != (J1.shape[1],) or not np.all(np.isfinite(got)):
+        return False
+    # J1 delta's rounding is relative to |J1| |delta| (the secondary's part is large where
+    # e1 is small), not to J1 J1+ e1
+    scale = np.linalg.norm(J1, 2) * max(np.abs(got).max(initial=0.0), 1e-300)
+    return any(_close(J1 @ got, J1 @ first, rtol=1e-6, atol=1e-8, scale=scale)
+               for first in _first_steps(J1, e1, lam))
 
 
 HAND = {

@@ -1,19 +1,26 @@
-"""The reference rule: what the grader guarantees about ikteach's own answers, and what it only
-reports.
+"""The reference rule (docs/lecturers.md, "The reference rule"): what the grader guarantees
+about ikteach's own answers, how the check cell applies the same rule, and what is only
+reported.
 
 Guaranteed (with bubblewrap): while exercise N is graded, every process of its sandbox (the
 fork server, the notebook's run, the checks' worker, anything they start) sees a COPY of
 ikteach (sandbox_copy) in which exercise N's reference functions (its check module's
 REFERENCES) have a body that raises ReferenceBlocked, and which holds no checker and no
 self-check answer. A reload, an exec of ikteach's source file, a fresh interpreter, a pickle
-by reference: all find the stub. The expected values are computed in the grader's own
-process, outside the sandbox; only the student's outputs come back.
+by reference, a method object that runs a reference: all find the stub. The expected values
+are computed in the grader's own process, outside the sandbox; only the student's outputs
+come back.
+
+The check cell (reached()): the references a student's functions reach through what their
+code names (globals, imports at any level, attribute chains, literal strings, defaults,
+closures, classes, containers, and ikteach's own functions on the way) give the same 0.
 
 Reported, not prevented: a notebook that carries ikteach's code in itself (its source typed or
 pasted in, a marshalled code object, an exec'd string). That is copying, which only a reader
-can judge; fingerprint() makes it visible: a code object's hash that ignores names,
-docstrings, file names and line numbers, compared with the references' and the self-check's
-(copied()). The grader writes what matched into grades.csv and the feedback.
+can judge; fingerprint() makes an exact copy visible: a code object's operations, names,
+docstrings, file names and line numbers ignored, compared with the references' (copied():
+what matched and how many operations). Reordered, rewritten or split code is not seen. The
+work is bounded whatever a file holds (MAX_CODES, MAX_CODE_BYTES, MAX_TOTAL_BYTES).
 """
 import ast
 import compileall
@@ -23,6 +30,7 @@ import importlib
 import os
 import py_compile
 import shutil
+import sys
 import tempfile
 import types
 from pathlib import Path
@@ -31,7 +39,6 @@ from pathlib import Path
 # answer, the bundles; left out of the sandbox's copy
 LEFT_OUT = ("course/check", "course/grade.py", "course/grading/selfcheck.py",
             "course/grading/gradescope.py", "course/grading/autograder.py")
-MIN_CODE_BYTES = 40  # smaller functions (a one-line wrapper) are too common to report
 
 
 def _stub_body(qualname, exercise):
@@ -96,6 +103,31 @@ def sandbox_copy(package, dest, references=(), exercise=None, base=None):
 
 
 # --- fingerprints: copied code, reported ---------------------------------------------------
+# Cheap by construction, whatever a student's file holds: each code object is read once (a
+# nested one is a token, not entered again), at most MAX_CODES of them, none longer than
+# MAX_CODE_BYTES (a reference is far shorter), and a constant is shown only when it is small.
+
+MIN_OPERATIONS = 20      # shorter functions (a one-line wrapper) are too common to report
+MAX_CODE_BYTES = 16384   # longer code cannot be a reference's (the longest is ~1 kB): skipped
+MAX_CODES = 400          # code objects compared per notebook (the rest are not)
+MAX_TOTAL_BYTES = 1 << 20  # compiled code read per notebook, in all
+MAX_NAMES = 300          # names of one function followed (the instant check, held_code)
+MAX_REACHED = 20000      # objects followed from a namespace or a student's functions
+
+
+def _constant(const):
+    if isinstance(const, types.CodeType):
+        return "code"  # compared on its own (fingerprints), not entered here
+    if isinstance(const, bool) or not isinstance(const, (int, float, complex, tuple)):
+        return None
+    if isinstance(const, int) and const.bit_length() > 64:
+        return "const big int"
+    if isinstance(const, tuple) and (len(const) > 8 or not all(
+            isinstance(c, (int, float, str, type(None))) and not (
+                isinstance(c, int) and c.bit_length() > 64) for c in const)):
+        return f"const tuple of {len(const)}"
+    return f"const {const!r:.80}"
+
 
 def _operations(code):
     """What `code` does, instruction by instruction: the operations, their numbers and
@@ -106,13 +138,7 @@ def _operations(code):
             continue
         name = "LOAD_ATTR" if ins.opname == "LOAD_METHOD" else ins.opname
         if name == "LOAD_CONST":
-            const = ins.argval
-            if isinstance(const, types.CodeType):
-                yield f"code {fingerprint(const)}"
-            elif isinstance(const, (int, float, complex, tuple)) and not isinstance(const, bool):
-                yield f"const {const!r}"
-            else:
-                yield name
+            yield _constant(ins.argval) or name
         elif name in ("BINARY_OP", "COMPARE_OP", "CALL", "PRECALL", "CALL_FUNCTION_EX"):
             yield f"{name} {ins.argrepr or ins.arg}"
         else:
@@ -120,22 +146,57 @@ def _operations(code):
 
 
 def fingerprint(code):
-    """A hash of what `code` does (_operations), not of its names, docstring, file or line
-    numbers: a copy with renamed variables matches."""
-    return hashlib.sha256("\n".join(_operations(code)).encode()).hexdigest()[:24]
+    """(a hash of what `code` does (_operations), not of its names, docstring, file or line
+    numbers: a copy with renamed variables matches; how many operations that is)."""
+    operations = list(_operations(code))
+    return hashlib.sha256("\n".join(operations).encode()).hexdigest()[:24], len(operations)
 
 
-def _codes(code):
-    yield code
-    for const in code.co_consts:
-        if isinstance(const, types.CodeType):
-            yield from _codes(const)
+def _codes(code, limit=MAX_CODES):
+    """`code` and the code nested in it, breadth first, at most `limit` (no recursion: a
+    deeply nested cell costs no stack)."""
+    queue, seen = [code], 0
+    while queue and seen < limit:
+        current = queue.pop(0)
+        seen += 1
+        yield current
+        queue += [c for c in current.co_consts if isinstance(c, types.CodeType)]
 
 
 def fingerprints(codes):
-    """{hash: function name} of every function in `codes` and nested in them (big enough)."""
-    return {fingerprint(c): c.co_name for code in codes for c in _codes(code)
-            if c.co_name != "<module>" and len(c.co_code) >= MIN_CODE_BYTES}
+    """{hash: function name} of every function in `codes` and nested in them (at least
+    MIN_OPERATIONS long, at most MAX_CODES of them in all)."""
+    out, left, budget = {}, MAX_CODES, MAX_TOTAL_BYTES
+    for code in codes:
+        for c in _codes(code, left):
+            left -= 1
+            if c.co_name == "<module>" or len(c.co_code) > min(MAX_CODE_BYTES, budget):
+                continue
+            budget -= len(c.co_code)
+            digest, count = fingerprint(c)
+            if count >= MIN_OPERATIONS:
+                out[f"{digest}:{count}"] = c.co_name[:80]
+        if left <= 0:
+            break
+    return out
+
+
+def source_fingerprints(cells, max_chars=200_000):
+    """fingerprints() of a notebook's code cells ([(number, source)]) compiled here, cells
+    longer than `max_chars` skipped (no reference is near that long; compiling a crafted
+    megabyte would cost the grader memory and time outside any limit)."""
+    from .extract import without_magics
+
+    found = {}
+    for number, source in cells:
+        if len(source) > max_chars:
+            continue
+        try:
+            found.update(fingerprints([compile(without_magics(source), f"<cell {number}>",
+                                               "exec")]))
+        except (SyntaxError, ValueError, RecursionError, MemoryError):
+            continue  # not Python: the worker's notes say so
+    return found
 
 
 def _python_function(obj):
@@ -146,50 +207,100 @@ def _python_function(obj):
     return None
 
 
-def reference_fingerprints(references, extra_sources=()):
-    """{hash: what it is} of ikteach's reference functions and of answers given as source."""
+def reference_fingerprints(references):
+    """{hash: what it is} of ikteach's reference functions ("ikteach.core.x:fn")."""
     out = {}
     for ref in references:
         module, name = ref.split(":")
         fn = _python_function(getattr(importlib.import_module(module), name))
         if fn is not None:
             out.update({h: f"{module}.{name}" for h in fingerprints([fn.__code__])})
-    for label, source in extra_sources:
-        out.update({h: label for h in fingerprints([compile(source, label, "exec")])})
     return out
 
 
-def _reachable(roots, depth=4):
-    """Every object `roots` lead to through what their code names: functions and their
-    wrappers (jit, partial, bound methods, a callable's __call__), the globals and module
-    attributes (ik.jacobian) their code names, their defaults and closures, classes' methods,
-    containers' items. ikteach's own functions are reached, not entered."""
-    seen = {}
+_LIBRARY = tuple({sys.prefix, sys.base_prefix, os.path.dirname(os.__file__)})
+_IKTEACH = str(Path(__file__).resolve().parents[2])  # ikteach/
 
-    def visit(obj, left):
-        if obj is None or id(obj) in seen or left < 0:
-            return
-        seen[id(obj)] = obj
-        inner = [getattr(obj, a, None) for a in ("__wrapped__", "__func__", "func")]
-        if isinstance(obj, type):
-            inner += list(vars(obj).values())
-        elif isinstance(obj, (list, tuple, dict)):
-            inner += list(obj.values() if isinstance(obj, dict) else obj)[:100]
-        elif isinstance(obj, types.FunctionType):
-            if not str(obj.__module__).startswith("ikteach"):
-                names = {n for code in _codes(obj.__code__) for n in code.co_names}
-                values = [obj.__globals__.get(n) for n in names]
-                inner += values + [vars(v).get(n) for v in values  # not a module's __getattr__
-                                   if isinstance(v, types.ModuleType) for n in names]
-                inner += list(obj.__defaults__ or ()) + [_content(c) for c in obj.__closure__ or ()]
-        elif not isinstance(obj, types.ModuleType):
-            inner.append(getattr(type(obj), "__call__", None))
-        for value in inner:
-            visit(value, left - 1)
 
-    for root in roots:
+def _is_ikteach(obj):
+    module = str(getattr(obj, "__module__", "") or "")
+    code = getattr(obj, "__code__", None)
+    return module == "ikteach" or module.startswith("ikteach.") or (
+        code is not None and code.co_filename.startswith(_IKTEACH))
+
+
+def _entered(fn, into_ikteach):
+    """Is `fn`'s code followed? The student's (a cell's, the notebook's), and ikteach's when
+    `into_ikteach`; never a library's (numpy's, JAX's: they do not call ikteach)."""
+    if _is_ikteach(fn):
+        return into_ikteach
+    return not fn.__code__.co_filename.startswith(_LIBRARY)
+
+
+def _named(fn):
+    """What `fn`'s code names: the globals it loads, the modules it imports (at any level),
+    and every attribute chain through them (`ik.core.stop_rules.joint_steps`); strings it
+    holds count as names too (`getattr(ik, "jt_step")`, `import_module("ikteach.core.jt")`)."""
+    names = []
+    for code in _codes(fn.__code__, 50):
+        names += code.co_names
+        names += [c for c in code.co_consts if isinstance(c, str) and len(c) < 200]
+    names = list(dict.fromkeys(names))[:MAX_NAMES]
+    found = [fn.__globals__.get(n) for n in names]
+    modules = [v for v in found if isinstance(v, types.ModuleType)]
+    modules += [m for m in map(sys.modules.get, names) if m is not None]  # imported, read only
+    for module in modules:  # grows while it is read: the chains
+        if len(modules) > 50:
+            break
         try:
-            visit(root, depth)
+            attributes = vars(module)
+        except TypeError:
+            continue
+        for n in names:
+            value = attributes.get(n)  # not getattr: no module __getattr__ runs
+            if isinstance(value, types.ModuleType):
+                if all(value is not m for m in modules):
+                    modules.append(value)
+            elif value is not None:
+                found.append(value)
+    return [v for v in found if not isinstance(v, types.ModuleType)]
+
+
+def _inner(obj, into_ikteach):
+    inner = [getattr(obj, a, None) for a in ("__wrapped__", "__func__", "func")]
+    if isinstance(obj, type):
+        inner += list(vars(obj).values()) + [b for b in obj.__mro__[1:] if b is not object]
+    elif isinstance(obj, (list, tuple, set, frozenset)):
+        inner += list(obj)[:100]
+    elif isinstance(obj, dict):
+        inner += list(obj.values())[:100]
+    elif isinstance(obj, types.FunctionType):
+        if _entered(obj, into_ikteach):
+            inner += _named(obj)
+            inner += list(obj.__defaults__ or ()) + list((obj.__kwdefaults__ or {}).values())
+            inner += [_content(c) for c in obj.__closure__ or ()]
+    elif not isinstance(obj, (types.ModuleType, types.CodeType)):
+        inner += [getattr(type(obj), "__call__", None), type(obj)]
+    return inner
+
+
+def _reachable(roots, into_ikteach=False, limit=MAX_REACHED, stop=frozenset()):
+    """Every object `roots` lead to through what their code names: functions and their
+    wrappers (jit, partial, bound methods, a callable's __call__), the globals, imports and
+    attribute chains (ik.core.jt.jt_step) their code names, their defaults and closures,
+    classes' methods and bases, an object's class, containers' items. ikteach's own
+    functions are entered when `into_ikteach` (a method object's step), otherwise reached
+    only; library code is never entered, nor the objects whose ids are in `stop`."""
+    seen, queue = {}, list(roots)
+    while queue and len(seen) < limit:
+        obj = queue.pop()
+        if obj is None or id(obj) in seen or isinstance(obj, (str, bytes, int, float)):
+            continue
+        seen[id(obj)] = obj
+        if id(obj) in stop:
+            continue
+        try:
+            queue += _inner(obj, into_ikteach)
         except Exception:  # noqa: BLE001 - a student's odd object: not entered
             continue
     return list(seen.values())
@@ -211,20 +322,26 @@ def held_code(namespace):
 
 
 def reached(functions, references):
-    """The references ("ikteach.core.x:fn") that `functions` reach by what their code names
-    (for the instant check: in the grader's sandbox those are stubs that raise)."""
+    """The references ("ikteach.core.x:fn") that `functions` reach by what their code names,
+    ikteach's own functions entered (a method object such as ik.DLS reaches the step it
+    runs): the instant check's side of the reference rule (in the grader's sandbox those
+    functions are stubs that raise, however they are reached)."""
     targets = {}
     for ref in references:
         module, name = ref.split(":")
         obj = getattr(importlib.import_module(module), name)
         targets.update({id(obj): ref, id(_python_function(obj)): ref})
-    return sorted({targets[id(o)] for o in _reachable(functions) if id(o) in targets})
+    found = _reachable(functions, into_ikteach=True, stop=frozenset(targets))
+    return sorted({targets[id(o)] for o in found if id(o) in targets})
 
 
 def copied(found, references):
     """Lines for the instructor: which of the notebook's functions (`found`: {hash: name})
-    have the same code as a reference (`references`: {hash: what})."""
-    lines = sorted({f"`{name}` has the same code as {references[h]}"
+    compile to the same operations as a reference (`references`: {hash: what}), and how many
+    operations that is."""
+    lines = sorted({f"`{name}` has the same code as {references[h]}: all its "
+                    f"{h.rsplit(':', 1)[-1]} compiled operations in the same order, names "
+                    "ignored (code written independently from the same formula can match "
+                    "too: read both)"
                     for h, name in found.items() if h in references})
     return lines[:5]
-
