@@ -20,6 +20,9 @@ nb_execution_mode = "off"
 nb_mime_priority_overrides = [("html", "application/vnd.jupyter.widget-view+json", None)]
 nb_ipywidgets_js = {}
 myst_enable_extensions = ["dollarmath", "amsmath"]
+# The notebooks put a `$$ ... $$` display on its own lines inside a paragraph (as JupyterLab,
+# nbconvert and the slides read it); without this, dollarmath pairs those dollars wrongly.
+myst_dmath_double_inline = True
 myst_heading_anchors = 3  # links like guide.md#a-heading work as on GitHub
 
 # MathJax 3 from node_modules (copied in by the stager): SVG output, so no font files to load.

@@ -116,6 +116,32 @@ def test_the_leak_check_finds_a_solution_line():
     assert leaks(f"<p>some page</p>\n{lines[0]}\n", lines) == [lines[0]]
 
 
+# What a page shows as prose once code, scripts and MathJax's own math elements are left out.
+NOT_PROSE = re.compile(r"<(pre|script|style|code|textarea)\b.*?</\1>"
+                       r"|<(span|div) class=\"math\b[^\"]*\">.*?</\2>", re.S)
+RAW_TEX = re.compile(r"\$|\\[a-zA-Z]+")
+
+
+def raw_tex(page_html):
+    """TeX a reader would see as text: a dollar or a \\command outside math and code."""
+    prose = html.unescape(re.sub(r"<[^>]+>", " ", NOT_PROSE.sub(" ", page_html)))
+    return [prose[max(0, m.start() - 30):m.end() + 30] for m in RAW_TEX.finditer(prose)]
+
+
+def test_no_raw_tex_outside_math_and_code(pages):
+    found = {path.name: raw_tex(path.read_text(encoding="utf-8"))[:2] for path in pages}
+    assert {name: tex for name, tex in found.items() if tex} == {}
+    text = (next(p for p in pages if p.name == "08_methods_compared.html")).read_text(
+        encoding="utf-8")
+    assert "(Buss &amp; Kim write" in NOT_PROSE.sub("", text)  # prose stays prose, not math
+
+
+def test_the_raw_tex_check_finds_tex_in_prose():
+    page = ('<p>keep <span class="math notranslate nohighlight">\\(\\lambda\\)</span> and '
+            '<code>$HOME</code></p><p>but $x = \\frac{1}{2}$ shows</p>')
+    assert len(raw_tex(page)) == 3
+
+
 def test_every_image_has_alt_text(pages):
     for path, page in pages.items():
         for image in page.images:
