@@ -18,6 +18,7 @@ to a file of the repository that is not a page of the book points at the reposit
 """
 import argparse
 import base64
+import copy
 import html
 import json
 import os
@@ -40,6 +41,9 @@ LINK = re.compile(r"(\]\()([^)\s]+)(\))")
 DATA_IMG = re.compile(r"<img\b[^>]*>")
 WIDGET = "application/vnd.jupyter.widget-view+json"
 STILL = "(a still: run the notebook"  # the caption of a widget's still (pictures/stills.py)
+ANIMATION_STILL = '<img alt="Still frame of an animation.'  # pictures/frames.py show()
+PLAYER = '<div class="animation">'  # matplotlib's JavaScript player
+UNNAMED_SLIDER = re.compile(r'(<input\b(?![^>]*\baria-label=)[^>]*class="anim-slider")')
 
 
 def lectures(root=ROOT):
@@ -119,6 +123,27 @@ def launch_cell(repo_path, h, widgets):
     return {"cell_type": "markdown", "metadata": {}, "source": text}
 
 
+def _html(output):
+    return "".join(output.get("data", {}).get("text/html", ""))
+
+
+def one_animation(outputs):
+    """A cell's outputs with each animation shown once: the still frame that pictures.frames.show
+    puts before its player is left out (the player shows that frame first), and the player's
+    frame slider gets a name (matplotlib's has none: axe's `label`)."""
+    kept = []
+    for i, out in enumerate(outputs):
+        later = "".join(_html(o) for o in outputs[i + 1:i + 2])
+        if _html(out).lstrip().startswith(ANIMATION_STILL) and PLAYER in later:
+            continue
+        if PLAYER in _html(out):
+            out = copy.deepcopy(out)
+            out["data"]["text/html"] = UNNAMED_SLIDER.sub(
+                r'\1 aria-label="Animation frame"', _html(out))
+        kept.append(out)
+    return kept
+
+
 def stage_notebook(src, root, h, mapping):
     """The book's copy of a notebook: links fixed, the launch line under the title."""
     repo_path = src.relative_to(root).as_posix()
@@ -126,6 +151,8 @@ def stage_notebook(src, root, h, mapping):
     for cell in book["cells"]:
         if cell["cell_type"] == "markdown":
             cell["source"] = rewrite_links(_source(cell), repo_path, h, mapping)
+        elif cell.get("outputs"):
+            cell["outputs"] = one_animation(cell["outputs"])
     first = next(i for i, c in enumerate(book["cells"]) if c["cell_type"] == "markdown")
     book["cells"].insert(first + 1, launch_cell(repo_path, h, has_widgets(book)))
     for cell in book["cells"]:
