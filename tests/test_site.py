@@ -199,6 +199,29 @@ def test_home_page_has_a_picture_and_a_line_per_lecture(site, pages):
         assert re.sub(r"\s+", " ", line.replace("`", ""))[:40] in re.sub(r"\s+", " ", text)
 
 
+def test_the_home_page_shows_one_column_of_the_lectures_table():
+    lines = book.lecture_lines(ROOT)
+    assert len(lines) == len(book.lectures(ROOT))
+    for name, line in lines.items():
+        assert " | " not in line and "core/" not in line, f"{name}: {line}"
+
+
+def test_the_notation_table_shows_subscripts_as_written(site):
+    text = page_text(site / "notation.html")
+    assert "A⁺_λ, J⁺_{1,λ}" in text and "[J]_{ri}, J_{:,i}" in text
+    assert "<em>" not in re.sub(r"(?s).*<main|</main>.*", "", (site / "notation.html").read_text(encoding="utf-8"))
+
+
+def test_each_animation_is_shown_once_with_a_named_slider(site):
+    for path in book.lectures(ROOT):
+        text = (site / "notebooks" / f"{path.stem}.html").read_text(encoding="utf-8")
+        players = text.count('<div class="animation">')
+        sliders = re.findall(r'<input\b[^>]*type="range"[^>]*>', text)
+        assert len(sliders) == players and all('aria-label="' in s for s in sliders), path.name
+        if players:
+            assert "Still frame of an animation" not in text, path.name
+
+
 def test_headings_go_down_one_level_at_a_time(pages):
     for path, page in pages.items():
         levels = [int(h[1]) for h in re.findall(r"<(h[1-6])[ >]", path.read_text(encoding="utf-8"))]

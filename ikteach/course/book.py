@@ -181,7 +181,7 @@ def first_picture(book):
 def lecture_lines(root=ROOT):
     """{notebook name: what it derives and checks}: the rows of notebooks/README.md's table."""
     text = (Path(root) / "notebooks" / "README.md").read_text(encoding="utf-8")
-    rows = re.findall(r"^\|\s*`(\d\d_[\w-]+\.ipynb)`[^|]*\|\s*(.+?)\s*\|\s*$", text, re.M)
+    rows = re.findall(r"^\|\s*`(\d\d_[\w-]+\.ipynb)`[^|]*\|\s*((?:\\\||[^|])+?)\s*\|", text, re.M)
     return {name: line.replace("\\|", "|") for name, line in rows}
 
 
@@ -218,13 +218,24 @@ def toctree(caption, entries):
     return "\n".join(["```{toctree}", ":hidden:", f":caption: {caption}", "", *entries, "```", ""])
 
 
+KEEP_AS_IS = re.compile(r"(`[^`\n]*`|\]\([^)\n]*\)|</?[a-zA-Z][^>\n]*>)")  # code, a link's target, a tag
+
+
+def literal_underscores(text):
+    """Markdown text whose underscores show as written (A⁺_λ, J⁺_{1,λ}), not as emphasis;
+    code spans, link targets and HTML tags are left alone."""
+    parts = KEEP_AS_IS.split(text)
+    return "".join(part if i % 2 else re.sub(r"(?<!\\)_", r"\\_", part)
+                   for i, part in enumerate(parts))
+
+
 def notation_page(root, h, mapping):
-    """notation.md: the notation section of notebooks/README.md."""
+    """notation.md: the notation section of notebooks/README.md, symbols as written."""
     text = (Path(root) / "notebooks" / "README.md").read_text(encoding="utf-8")
     start = text.index('<a id="notation"></a>')
     section = text[start:].split("\n", 1)[1]
     section = re.sub(r"^## Notation.*$", "# Notation", section, count=1, flags=re.M)
-    return rewrite_links(section, "notebooks/README.md", h, mapping)
+    return literal_underscores(rewrite_links(section, "notebooks/README.md", h, mapping))
 
 
 def copy_mathjax(static):
