@@ -50,8 +50,8 @@ def site(tmp_path_factory):
 def pages(site):
     parsed = {}
     for path in site.rglob("*.html"):
-        if "_static" in path.relative_to(site).parts:
-            continue  # the theme's own files (e.g. a template), not pages
+        if {"_static", "slides"} & set(path.relative_to(site).parts):
+            continue  # the theme's own files (e.g. a template) and the decks, not pages
         page = Page()
         page.feed(path.read_text(encoding="utf-8"))
         parsed[path] = page
@@ -157,6 +157,24 @@ def test_every_internal_link_and_asset_resolves(site, pages):
             assert target.exists(), f"{path.relative_to(site)}: {url}"
             if parts.fragment and target.suffix == ".html" and target in ids:
                 assert unquote(parts.fragment) in ids[target], f"{path.relative_to(site)}: {url}"
+
+
+def test_the_published_folder_holds_no_cache_and_no_path_of_this_machine(site):
+    names = {p.name for p in site.rglob("*")}
+    assert not names & {".doctrees", ".buildinfo", "environment.pickle", "_sources"}
+    assert not list(site.rglob("*.pickle")) and not list(site.rglob("*.doctree"))
+    here = str(ROOT).encode()
+    assert [p for p in site.rglob("*") if p.is_file() and here in p.read_bytes()] == []
+
+
+def test_the_book_links_every_deck(site, pages):
+    index = pages[site / "index.html"]
+    for path in book.lectures(ROOT):
+        deck = f"slides/{path.stem}.slides.html"
+        assert deck in index.links and (site / deck).is_file(), deck
+        lecture = pages[site / "notebooks" / f"{path.stem}.html"]
+        assert f"../{deck}" in lecture.links, path.name
+    assert "slides/index.html" in index.links and (site / "slides" / "index.html").is_file()
 
 
 def test_the_theme_loads_nothing_from_another_site(site, pages):

@@ -10,7 +10,12 @@ myst-nb and sphinx-book-theme (docs/conf.py) into build/site:
 - a home page (what the course teaches, one line and a picture per lecture), the notation table
   of notebooks/README.md, and the guides of docs/ (students, lecturers, maintainers);
 - MathJax from the npm package (node_modules, `make node_modules`), copied into the site: the
-  book opens from disk with no network (a lecture hall).
+  book opens from disk with no network (a lecture hall);
+- the lectures' slides (ikteach.course.slides) in build/site/slides, linked from the home page
+  and from each lecture's page.
+
+The published folder holds pages and assets only: Sphinx's caches (.doctrees, .buildinfo)
+are kept outside it (build/book-cache).
 
 The staged copies (never the committed files) get a line of links at the top: "Open in Colab",
 "Binder" and "download the notebook", from the course's home in pyproject.toml. A relative link
@@ -29,10 +34,14 @@ import sys
 import time
 from pathlib import Path
 
-from .course_home import ROOT, home
+if __package__:
+    from .course_home import ROOT, home
+else:  # run as a file: `make site` from the light site venv (no JAX: see the Makefile)
+    from course_home import ROOT, home
 
 STAGE = ROOT / "build" / "book-src"
 OUT = ROOT / "build" / "site"
+CACHE = ROOT / "build" / "book-cache"  # Sphinx's doctrees: never in the published folder
 MATHJAX = ROOT / "node_modules" / "mathjax" / "es5"
 MATHJAX_FILES = ("tex-svg-full.js", "a11y", "ui", "sre", "adaptors")  # what the page may load
 ORIGINALS = "_notebooks"  # the committed notebooks as they are, for "download the notebook"
@@ -112,11 +121,20 @@ def has_widgets(book):
     return False
 
 
+def deck(repo_path):
+    """The book path of a lecture's slides, or None (exercises have none)."""
+    path = Path(repo_path)
+    return f"slides/{path.stem}.slides.html" if path.parent.as_posix() == "notebooks" else None
+
+
 def launch_cell(repo_path, h, widgets):
-    """The Markdown cell put under a page's title: Colab, Binder, the notebook's download."""
+    """The Markdown cell put under a page's title: Colab, Binder, the notebook's download and,
+    for a lecture, its slides."""
     original = os.path.relpath(f"{ORIGINALS}/{repo_path}", Path(repo_path).parent)
     text = (f"[Open in Colab]({h.colab_url(repo_path)}) · [Binder]({h.binder_url(repo_path)}) · "
             f"{{download}}`download the notebook <{original}>`")
+    if deck(repo_path):
+        text += f" · <a href=\"../{deck(repo_path)}\">the slides</a>"
     if widgets:
         text += ("\n\n*This page shows the interactive widgets as still pictures; the live "
                  "version needs a kernel: open the notebook on Colab, Binder or your laptop.*")
@@ -199,11 +217,13 @@ def home_page(root, h, thumbs):
            "[students' guide](guides/students.md).", "", "## Lectures", ""]
     for path in lectures(root):
         book = json.loads(path.read_text(encoding="utf-8"))
-        out += [f"### [{title(book)}](notebooks/{path.name})", ""]
+        out += [f"### [{title(book)}](notebooks/{path.name})", "",
+                f'<a href="{deck(f"notebooks/{path.name}")}">Slides</a> for the lecture hall.', ""]
         if path.stem in thumbs:
             out += [f"![{thumbs[path.stem]}](_static/thumbs/{path.stem}.png)", ""]
         out += [lines.get(path.name, ""), ""]
-    out += ["## Exercises", ""]
+    out += ["Every deck: <a href=\"slides/index.html\">the slides</a> (reveal.js, offline; "
+            "<kbd>F</kbd> full screen, <kbd>S</kbd> the speaker's notes).", "", "## Exercises", ""]
     for path in exercises(root):
         book = json.loads(path.read_text(encoding="utf-8"))
         out.append(f"- [{title(book)}](notebooks/exercises/{path.name})")
@@ -290,14 +310,28 @@ def stage(root=ROOT, dest=STAGE):
     return dest
 
 
-def build(out=OUT, root=ROOT, quiet=True):
-    """Stage and run Sphinx (docs/conf.py); returns the output folder."""
-    src = stage(root)
+def sphinx(src, out, builder="html", quiet=True):
+    """Run Sphinx on the staged folder; its caches go to CACHE, not into out."""
     shutil.rmtree(out, ignore_errors=True)  # nothing left over from an earlier build
-    cmd = [sys.executable, "-m", "sphinx", "-b", "html",
-           "-j", "auto", "-E", str(src), str(out)] + (["-q"] if quiet else [])
+    cmd = [sys.executable, "-m", "sphinx", "-b", builder, "-j", "auto", "-E",
+           "-d", str(CACHE / builder), str(src), str(out)] + (["-q"] if quiet else [])
     subprocess.run(cmd, check=True)
+    (Path(out) / ".buildinfo").unlink(missing_ok=True)  # the config's hash, nothing to read
+    if (Path(out) / "_sources").is_dir() and not any((Path(out) / "_sources").iterdir()):
+        (Path(out) / "_sources").rmdir()  # html_copy_source = False leaves it empty
     return Path(out)
+
+
+def build(out=OUT, root=ROOT, quiet=True):
+    """Stage and run Sphinx (docs/conf.py), then the lectures' slides into out/slides;
+    returns the output folder."""
+    if __package__:
+        from . import slides
+    else:
+        import slides
+    out = sphinx(stage(root), out, quiet=quiet)
+    slides.build(lectures(root), out / "slides")
+    return out
 
 
 def main(argv=None):
@@ -310,9 +344,11 @@ def main(argv=None):
     except subprocess.CalledProcessError as exc:
         print(f"site: sphinx-build failed (exit status {exc.returncode})", file=sys.stderr)
         return 1
-    pages_built = len(list(out.rglob("*.html"))) - len(list((out / "_static").rglob("*.html")))
-    print(f"site: {pages_built} pages in {out} ({time.perf_counter() - start:.0f} s); "
-          f"open {out / 'index.html'}")
+    pages_built = len([p for p in out.rglob("*.html")
+                       if p.relative_to(out).parts[0] not in ("_static", "slides")])
+    decks = len(list((out / "slides").glob("*.slides.html")))
+    print(f"site: {pages_built} pages and {decks} decks in {out} "
+          f"({time.perf_counter() - start:.0f} s); open {out / 'index.html'}")
     return 0
 
 

@@ -285,7 +285,10 @@ def copy_assets(out):
     if not (reveal / "dist" / "reveal.js").is_file() or not mathjax.is_dir():
         raise SystemExit(f"slides: reveal.js or MathJax missing in {NODE}: run "
                          "`make node_modules` (npm ci: installs package-lock.json)")
-    shutil.copytree(reveal / "dist", out / "reveal.js" / "dist", dirs_exist_ok=True)
+    other_themes = shutil.ignore_patterns(*[p.name for p in (reveal / "dist" / "theme").glob("*.css")
+                                            if p.name != "white.css"])  # some load web fonts
+    shutil.copytree(reveal / "dist", out / "reveal.js" / "dist", dirs_exist_ok=True,
+                    ignore=other_themes)
     shutil.copytree(reveal / "plugin" / "notes", out / "reveal.js" / "plugin" / "notes",
                     dirs_exist_ok=True)
     for name in ("tex-svg-full.js", "a11y", "ui", "sre", "adaptors"):
