@@ -14,7 +14,7 @@ export UV_PYTHON_DOWNLOADS := never
 # may not write them itself, e.g. PYTHONDONTWRITEBYTECODE, a read-only venv).
 SYNC := $(UV) sync --locked --inexact --extra dev --compile-bytecode
 
-.PHONY: lab test test-latest test-lowest lock lock-upgrade header notebooks strip bench clean exercises test-browser bench-browser site slides node_modules
+.PHONY: pdf lab test test-latest test-lowest lock lock-upgrade header notebooks strip bench clean exercises test-browser bench-browser site slides node_modules
 
 # uv itself comes from PyPI, into the venv (the lock then keeps it at its locked version).
 $(UV):
@@ -115,16 +115,25 @@ notebooks: $(STAMP)
 exercises: $(STAMP)
 	$(PY) -m ikteach.course.exercises build
 
-# The course as a static HTML book (build/site) and reveal.js slides (build/slides), from the
-# committed notebooks (never re-executed), offline: docs/lecturers.md, "Publish the course".
-site: $(STAMP) $(NODE_STAMP)
-	$(VENV)/bin/ikteach site
+# The course as a static HTML book with its reveal.js slides (build/site, the decks in
+# build/site/slides), from the committed notebooks (never re-executed), offline:
+# docs/lecturers.md, "Publish the course". Built in a venv of their own holding only the
+# `site` group of uv.lock (Sphinx, myst-nb, the theme, nbconvert: no JAX, no JupyterLab); the
+# scripts run as files, without importing the ikteach package.
+SITE_VENV ?= .venv-site
+SITE_STAMP := $(SITE_VENV)/.installed-stamp
+$(SITE_STAMP): pyproject.toml uv.lock | $(UV)
+	UV_PROJECT_ENVIRONMENT=$(SITE_VENV) $(UV) sync --locked --only-group site --quiet
+	@touch $(SITE_STAMP)
 
-slides: $(STAMP) $(NODE_STAMP)
-	$(VENV)/bin/ikteach slides
+site: $(SITE_STAMP) $(NODE_STAMP)
+	$(SITE_VENV)/bin/python ikteach/course/book.py
+
+slides: $(SITE_STAMP) $(NODE_STAMP)
+	$(SITE_VENV)/bin/python ikteach/course/slides.py
 
 clean:
-	rm -rf $(VENV) $(LATEST_VENV) $(LOWEST_VENV) .pytest_cache .hypothesis build node_modules
+	rm -rf $(VENV) $(LATEST_VENV) $(LOWEST_VENV) $(SITE_VENV) .pytest_cache .hypothesis build node_modules
 
 # Benchmarks print tables (never part of make test). The peer libraries of the bench extra
 # go into their own venv, so that they never change what the tests run against.

@@ -3,9 +3,12 @@
 Offline: the notebooks are read as committed (never executed), MathJax is served from the
 site's own _static folder, nothing is loaded from another site when a page is viewed.
 """
-from ikteach.course.course_home import home
+import json
+from pathlib import Path
 
-HOME = home()
+# The course's home (pyproject.toml), written next to this file by the stager (book.py): Sphinx
+# runs in the light site venv, which cannot import ikteach (no JAX there).
+HOME = json.loads((Path(__file__).parent / "course_home.json").read_text(encoding="utf-8"))
 project = "ikteach: inverse kinematics, derived and run"
 author = "the ikteach course"
 copyright = "the ikteach course authors (MIT licence)"
@@ -38,8 +41,8 @@ html_context = {"default_mode": "light"}  # readable on a projector; the reader 
 html_copy_source = False
 html_show_sourcelink = False
 html_theme_options = {
-    "repository_url": HOME.repository,
-    "repository_branch": HOME.branch,
+    "repository_url": HOME["repository"],
+    "repository_branch": HOME["branch"],
     "use_repository_button": True,
     "use_download_button": False,
     "show_toc_level": 2,

@@ -306,6 +306,8 @@ def stage(root=ROOT, dest=STAGE):
     for name in ("book.css", "book.js"):
         shutil.copy2(root / "docs" / name, dest / "_static" / name)
     shutil.copy2(root / "docs" / "conf.py", dest / "conf.py")
+    (dest / "course_home.json").write_text(json.dumps(
+        {"repository": h.repository, "branch": h.branch}), encoding="utf-8")
     copy_mathjax(dest / "_static")
     return dest
 
