@@ -95,9 +95,10 @@ binder/constraints.txt: uv.lock
 		--no-header -o $@
 
 # The course's public home (pyproject.toml [project.urls]) -> every notebook's first code cell
-# and the Colab/Binder badges in README.md and notebooks/README.md.
+# and the Colab/Binder badges in README.md and notebooks/README.md. `make header REF=v2026.1`
+# first points them at a tag (a term's release: docs/lecturers.md), `REF=main` back.
 header: $(STAMP)
-	$(PY) -m ikteach.course.notebook_header
+	$(PY) -m ikteach.course.notebook_header $(if $(REF),--ref $(REF))
 
 # Strip run noise (timestamps, widget state, kernel versions) from every committed notebook.
 strip: $(STAMP)

@@ -263,3 +263,13 @@ def test_a_missing_repository_says_what_to_set(tmp_path):
     (tmp_path / "pyproject.toml").write_text('[project]\nname = "ikteach"\n')
     with pytest.raises(SystemExit, match=r"\[project.urls\] Repository"):
         book.stage(tmp_path, tmp_path / "src")
+
+
+def test_the_site_group_is_the_site_extra():
+    """make site installs the `site` dependency group; `ikteach[site]` (in dev) the extra."""
+    import tomllib
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    extra = project["project"]["optional-dependencies"]["site"]
+    assert sorted(project["dependency-groups"]["site"]) == sorted(extra)
+    assert not any(re.match(r"(jax|jupyterlab|ikteach)\b", dep) for dep in extra)
