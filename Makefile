@@ -14,7 +14,7 @@ export UV_PYTHON_DOWNLOADS := never
 # may not write them itself, e.g. PYTHONDONTWRITEBYTECODE, a read-only venv).
 SYNC := $(UV) sync --locked --inexact --extra dev --compile-bytecode
 
-.PHONY: pdf lab test test-latest test-lowest lock lock-upgrade header notebooks strip bench clean exercises test-browser bench-browser site slides node_modules
+.PHONY: pdf test-browser-smoke lab test test-latest test-lowest lock lock-upgrade header notebooks strip bench clean exercises test-browser bench-browser site slides node_modules
 
 # uv itself comes from PyPI, into the venv (the lock then keeps it at its locked version).
 $(UV):
@@ -146,14 +146,25 @@ bench: $(STAMP)
 
 # A real browser (Debian's chromium + chromium-driver, driven by selenium) runs notebook 05 in
 # JupyterLab, drags the demo's slider and plays an animation, then runs every lecture notebook
-# (no error, nothing clipped, alt text on every image). Not part of `make test`.
+# (no error, nothing clipped, alt text on every image); then reads the book (every page at 375
+# and 1280 px, menus, search) and every deck at 1280 x 720. Not part of `make test`.
+# `make test-browser-smoke` (CI: .ci/run): every book page at 375 px, the menus, one deck.
 SUDO := $(if $(filter 0,$(shell id -u)),,sudo)
-test-browser: $(STAMP) $(NODE_STAMP)
+BROWSER_PREREQS := $(STAMP) $(NODE_STAMP)
+define browser_setup
 	@test -x /usr/bin/chromium -a -x /usr/bin/chromedriver || \
 	  { $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq chromium chromium-driver; }
 	$(PY) -m pip install --quiet "selenium>=4.20"
+endef
+test-browser: $(BROWSER_PREREQS)
+	$(browser_setup)
 	$(PY) -m pytest -v -p no:cacheprovider tests/browser/lab_05.py tests/browser/lab_notebooks.py \
-		tests/browser/site_book.py
+		tests/browser/site_book.py tests/browser/site_slides.py
+
+test-browser-smoke: $(BROWSER_PREREQS)
+	$(browser_setup)
+	$(PY) -m pytest -q -p no:cacheprovider -m smoke tests/browser/site_book.py \
+		tests/browser/site_slides.py
 
 # Browser latency (a benchmark: prints p50/p95, asserts nothing): slider -> picture redrawn
 # in JupyterLab in headless Chromium. Run on an idle machine; not part of `make test`.
