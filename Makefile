@@ -133,6 +133,12 @@ site: $(SITE_STAMP) $(NODE_STAMP)
 slides: $(SITE_STAMP) $(NODE_STAMP)
 	$(SITE_VENV)/bin/python ikteach/course/slides.py
 
+# One PDF of the whole book (build/book.pdf): Sphinx's singlehtml page printed by Debian's
+# Chromium once MathJax has typeset it (no LaTeX).
+pdf: $(SITE_STAMP) $(NODE_STAMP)
+	@test -x /usr/bin/chromium || { $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq chromium; }
+	$(SITE_VENV)/bin/python ikteach/course/book.py --pdf
+
 clean:
 	rm -rf $(VENV) $(LATEST_VENV) $(LOWEST_VENV) $(SITE_VENV) .pytest_cache .hypothesis build node_modules
 

@@ -336,11 +336,38 @@ def build(out=OUT, root=ROOT, quiet=True):
     return out
 
 
+PDF = ROOT / "build" / "book.pdf"
+CHROMIUM = "/usr/bin/chromium"  # Debian's, as the browser tests use (make test-browser)
+
+
+def pdf(out=PDF, root=ROOT, chromium=CHROMIUM, quiet=True):
+    """One PDF of the whole book: Sphinx's singlehtml builder (every page on one page), printed by
+    headless Chromium once MathJax has typeset it (no LaTeX). Returns the PDF's path."""
+    if not Path(chromium).is_file():
+        raise SystemExit(f"pdf: no Chromium at {chromium}: `make pdf` installs Debian's chromium")
+    single = sphinx(stage(root), ROOT / "build" / "book-single", builder="singlehtml", quiet=quiet)
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    subprocess.run([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
+                    "--disable-background-networking", "--no-pdf-header-footer",
+                    "--virtual-time-budget=600000", "--run-all-compositor-stages-before-draw",
+                    f"--print-to-pdf={out}", (single / "index.html").as_uri()],
+                   check=True, capture_output=quiet)
+    return out
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="ikteach site", description=__doc__.split("\n")[0])
     parser.add_argument("--out", type=Path, default=OUT, help="output folder (build/site)")
+    parser.add_argument("--pdf", action="store_true",
+                        help="one PDF of the book instead (build/book.pdf; needs Chromium)")
     args = parser.parse_args(argv)
     start = time.perf_counter()
+    if args.pdf:
+        path = pdf()
+        print(f"pdf: {path} ({path.stat().st_size / 1e6:.1f} MB, "
+              f"{time.perf_counter() - start:.0f} s)")
+        return 0
     try:
         out = build(args.out)
     except subprocess.CalledProcessError as exc:
