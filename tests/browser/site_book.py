@@ -101,8 +101,7 @@ def shoot(driver, name):
     driver.save_screenshot(str(SHOTS / name))
 
 
-@pytest.mark.smoke
-@pytest.mark.parametrize("width", ["phone", "laptop"])
+@pytest.mark.parametrize("width", [pytest.param("phone", marks=pytest.mark.smoke), "laptop"])
 def test_every_page_reads_right(site, driver, width):
     """Math typeset, no console error, no serious axe violation, nothing wider than the screen."""
     use_width(driver, width)
