@@ -37,6 +37,7 @@ html_title = "ikteach"
 html_static_path = ["_static"]
 html_css_files = ["book.css"]
 html_js_files = ["book.js"]
+html_favicon = "_static/favicon.svg"  # a served site asks for one (a 404 in the console)
 html_context = {"default_mode": "light"}  # readable on a projector; the reader may switch
 html_copy_source = False
 html_show_sourcelink = False

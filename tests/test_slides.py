@@ -121,6 +121,6 @@ def test_a_deck_loads_its_scripts_from_next_to_itself(tmp_path):
         assert not re.match(r"(https?:)?//", src), src
         assert (tmp_path / src).is_file(), src
     for href in re.findall(r'<link[^>]+href="([^"]+)"', text):
-        if not re.match(r"(https?:)?//", href):
+        if not re.match(r"(https?:)?//|data:", href):
             assert (tmp_path / href).is_file(), href
     assert "unpkg.com" not in text and "cdnjs" not in text and "require.js" not in text

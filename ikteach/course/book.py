@@ -303,7 +303,7 @@ def stage(root=ROOT, dest=STAGE):
             rewrite_links(text, f"docs/{guide}.md", h, mapping), encoding="utf-8")
     (dest / "notation.md").write_text(notation_page(root, h, mapping), encoding="utf-8")
     (dest / "index.md").write_text(home_page(root, h, thumbs), encoding="utf-8")
-    for name in ("book.css", "book.js"):
+    for name in ("book.css", "book.js", "favicon.svg"):
         shutil.copy2(root / "docs" / name, dest / "_static" / name)
     shutil.copy2(root / "docs" / "conf.py", dest / "conf.py")
     (dest / "course_home.json").write_text(json.dumps(
