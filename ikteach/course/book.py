@@ -2,7 +2,7 @@
 
     python -m ikteach.course.book [--out build/site]
 
-Stages a Sphinx source folder (build/book-src) from what is committed, then runs Sphinx with
+Stages a Sphinx source folder (build/site-src) from what is committed, then runs Sphinx with
 myst-nb and sphinx-book-theme (docs/conf.py) into build/site:
 
 - the lecture notebooks and the exercise templates, as committed: never re-executed (the outputs
@@ -15,7 +15,7 @@ myst-nb and sphinx-book-theme (docs/conf.py) into build/site:
   and from each lecture's page.
 
 The published folder holds pages and assets only: Sphinx's caches (.doctrees, .buildinfo)
-are kept outside it (build/book-cache).
+are kept outside it (build/site-cache; the staged sources in build/site-src).
 
 The staged copies (never the committed files) get a line of links at the top: "Open in Colab",
 "Binder" and "download the notebook", from the course's home in pyproject.toml. A relative link
@@ -39,9 +39,8 @@ if __package__:
 else:  # run as a file: `make site` from the light site venv (no JAX: see the Makefile)
     from course_home import ROOT, home
 
-STAGE = ROOT / "build" / "book-src"
+STAGE = ROOT / "build" / "site-src"  # beside(OUT, "src")
 OUT = ROOT / "build" / "site"
-CACHE = ROOT / "build" / "book-cache"  # Sphinx's doctrees: never in the published folder
 MATHJAX = ROOT / "node_modules" / "mathjax" / "es5"
 MATHJAX_FILES = ("tex-svg-full.js", "a11y", "ui", "sre", "adaptors")  # what the page may load
 ORIGINALS = "_notebooks"  # the committed notebooks as they are, for "download the notebook"
@@ -312,11 +311,17 @@ def stage(root=ROOT, dest=STAGE):
     return dest
 
 
+def beside(out, what):
+    """A working folder next to the output folder (build/site -> build/site-src): builds into
+    different folders never share one."""
+    return Path(out).parent / f"{Path(out).name}-{what}"
+
+
 def sphinx(src, out, builder="html", quiet=True):
-    """Run Sphinx on the staged folder; its caches go to CACHE, not into out."""
+    """Run Sphinx on the staged folder; its caches (doctrees) go beside out, never into it."""
     shutil.rmtree(out, ignore_errors=True)  # nothing left over from an earlier build
     cmd = [sys.executable, "-m", "sphinx", "-b", builder, "-j", "auto", "-E",
-           "-d", str(CACHE / builder), str(src), str(out)] + (["-q"] if quiet else [])
+           "-d", str(beside(out, "cache")), str(src), str(out)] + (["-q"] if quiet else [])
     subprocess.run(cmd, check=True)
     (Path(out) / ".buildinfo").unlink(missing_ok=True)  # the config's hash, nothing to read
     if (Path(out) / "_sources").is_dir() and not any((Path(out) / "_sources").iterdir()):
@@ -331,7 +336,7 @@ def build(out=OUT, root=ROOT, quiet=True):
         from . import slides
     else:
         import slides
-    out = sphinx(stage(root), out, quiet=quiet)
+    out = sphinx(stage(root, beside(out, "src")), out, quiet=quiet)
     slides.build(lectures(root), out / "slides")
     return out
 
@@ -345,7 +350,8 @@ def pdf(out=PDF, root=ROOT, chromium=CHROMIUM, quiet=True):
     headless Chromium once MathJax has typeset it (no LaTeX). Returns the PDF's path."""
     if not Path(chromium).is_file():
         raise SystemExit(f"pdf: no Chromium at {chromium}: `make pdf` installs Debian's chromium")
-    single = sphinx(stage(root), ROOT / "build" / "book-single", builder="singlehtml", quiet=quiet)
+    single = ROOT / "build" / "book-single"
+    single = sphinx(stage(root, beside(single, "src")), single, builder="singlehtml", quiet=quiet)
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     subprocess.run([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
