@@ -14,7 +14,7 @@ export UV_PYTHON_DOWNLOADS := never
 # may not write them itself, e.g. PYTHONDONTWRITEBYTECODE, a read-only venv).
 SYNC := $(UV) sync --locked --inexact --extra dev --compile-bytecode
 
-.PHONY: warm lab test test-latest test-lowest lock lock-upgrade header notebooks strip bench clean exercises test-browser bench-browser site slides node_modules
+.PHONY: warm pdf test-browser-smoke lab test test-latest test-lowest lock lock-upgrade header notebooks strip bench clean exercises test-browser bench-browser site slides node_modules
 
 # uv itself comes from PyPI, into the venv (the lock then keeps it at its locked version).
 $(UV):
@@ -100,9 +100,10 @@ binder/constraints.txt: uv.lock
 		--no-header -o $@
 
 # The course's public home (pyproject.toml [project.urls]) -> every notebook's first code cell
-# and the Colab/Binder badges in README.md and notebooks/README.md.
+# and the Colab/Binder badges in README.md and notebooks/README.md. `make header REF=v2026.1`
+# first points them at a tag (a term's release: docs/lecturers.md), `REF=main` back.
 header: $(STAMP)
-	$(PY) -m ikteach.course.notebook_header
+	$(PY) -m ikteach.course.notebook_header $(if $(REF),--ref $(REF))
 
 # Strip run noise (timestamps, widget state, kernel versions) from every committed notebook.
 strip: $(STAMP)
@@ -120,16 +121,31 @@ notebooks: $(STAMP)
 exercises: $(STAMP)
 	$(PY) -m ikteach.course.exercises build
 
-# The course as a static HTML book (build/site) and reveal.js slides (build/slides), from the
-# committed notebooks (never re-executed), offline: docs/lecturers.md, "Publish the course".
-site: $(STAMP) $(NODE_STAMP)
-	$(VENV)/bin/ikteach site
+# The course as a static HTML book with its reveal.js slides (build/site, the decks in
+# build/site/slides), from the committed notebooks (never re-executed), offline:
+# docs/lecturers.md, "Publish the course". Built in a venv of their own holding only the
+# `site` group of uv.lock (Sphinx, myst-nb, the theme, nbconvert: no JAX, no JupyterLab); the
+# scripts run as files, without importing the ikteach package.
+SITE_VENV ?= .venv-site
+SITE_STAMP := $(SITE_VENV)/.installed-stamp
+$(SITE_STAMP): pyproject.toml uv.lock | $(UV)
+	UV_PROJECT_ENVIRONMENT=$(SITE_VENV) $(UV) sync --locked --only-group site --quiet
+	@touch $(SITE_STAMP)
 
-slides: $(STAMP) $(NODE_STAMP)
-	$(VENV)/bin/ikteach slides
+site: $(SITE_STAMP) $(NODE_STAMP)
+	$(SITE_VENV)/bin/python ikteach/course/book.py
+
+slides: $(SITE_STAMP) $(NODE_STAMP)
+	$(SITE_VENV)/bin/python ikteach/course/slides.py
+
+# One PDF of the whole book (build/book.pdf): Sphinx's singlehtml page printed by Debian's
+# Chromium once MathJax has typeset it (no LaTeX).
+pdf: $(SITE_STAMP) $(NODE_STAMP)
+	@test -x /usr/bin/chromium || { $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq chromium; }
+	$(SITE_VENV)/bin/python ikteach/course/book.py --pdf
 
 clean:
-	rm -rf $(VENV) $(LATEST_VENV) $(LOWEST_VENV) .pytest_cache .hypothesis build node_modules
+	rm -rf $(VENV) $(LATEST_VENV) $(LOWEST_VENV) $(SITE_VENV) .pytest_cache .hypothesis build node_modules
 
 # Benchmarks print tables (never part of make test). The peer libraries of the bench extra
 # go into their own venv, so that they never change what the tests run against.
@@ -141,14 +157,25 @@ bench: $(STAMP)
 
 # A real browser (Debian's chromium + chromium-driver, driven by selenium) runs notebook 05 in
 # JupyterLab, drags the demo's slider and plays an animation, then runs every lecture notebook
-# (no error, nothing clipped, alt text on every image). Not part of `make test`.
+# (no error, nothing clipped, alt text on every image); then reads the book (every page at 375
+# and 1280 px, menus, search) and every deck at 1280 x 720. Not part of `make test`.
+# `make test-browser-smoke` (CI: .ci/run): every book page at 375 px, the menus, one deck.
 SUDO := $(if $(filter 0,$(shell id -u)),,sudo)
-test-browser: $(STAMP) $(NODE_STAMP)
+BROWSER_PREREQS := $(STAMP) $(NODE_STAMP)
+define browser_setup
 	@test -x /usr/bin/chromium -a -x /usr/bin/chromedriver || \
 	  { $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq chromium chromium-driver; }
 	$(PY) -m pip install --quiet "selenium>=4.20"
+endef
+test-browser: $(BROWSER_PREREQS)
+	$(browser_setup)
 	$(PY) -m pytest -v -p no:cacheprovider tests/browser/lab_05.py tests/browser/lab_notebooks.py \
-		tests/browser/site_book.py
+		tests/browser/site_book.py tests/browser/site_slides.py
+
+test-browser-smoke: $(BROWSER_PREREQS)
+	$(browser_setup)
+	$(PY) -m pytest -q -p no:cacheprovider -m smoke tests/browser/site_book.py \
+		tests/browser/site_slides.py
 
 # Browser latency (a benchmark: prints p50/p95, asserts nothing): slider -> picture redrawn
 # in JupyterLab in headless Chromium. Run on an idle machine; not part of `make test`.

@@ -251,6 +251,8 @@ def test_animation_html_plays_offline_no_cdn_and_every_button_has_an_icon(kind):
     buttons = re.findall(r"<button\b.*?</button>", page, re.S)
     assert len(buttons) == 9 and all(b.count("<svg") == 1 and "<i " not in b for b in buttons)
     assert all(re.search(r'aria-label="[A-Z][a-z ]+"', b) for b in buttons)
+    sliders = re.findall(r"<input\b[^>]*type=\"range\"[^>]*>", page)
+    assert len(sliders) == 1 and 'aria-label="Animation frame"' in sliders[0]
 
 
 def test_offline_refuses_a_page_with_an_icon_it_does_not_know():

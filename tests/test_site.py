@@ -50,8 +50,8 @@ def site(tmp_path_factory):
 def pages(site):
     parsed = {}
     for path in site.rglob("*.html"):
-        if "_static" in path.relative_to(site).parts:
-            continue  # the theme's own files (e.g. a template), not pages
+        if {"_static", "slides"} & set(path.relative_to(site).parts):
+            continue  # the theme's own files (e.g. a template) and the decks, not pages
         page = Page()
         page.feed(path.read_text(encoding="utf-8"))
         parsed[path] = page
@@ -116,6 +116,32 @@ def test_the_leak_check_finds_a_solution_line():
     assert leaks(f"<p>some page</p>\n{lines[0]}\n", lines) == [lines[0]]
 
 
+# What a page shows as prose once code, scripts and MathJax's own math elements are left out.
+NOT_PROSE = re.compile(r"<(pre|script|style|code|textarea)\b.*?</\1>"
+                       r"|<(span|div) class=\"math\b[^\"]*\">.*?</\2>", re.S)
+RAW_TEX = re.compile(r"\$|\\[a-zA-Z]+")
+
+
+def raw_tex(page_html):
+    """TeX a reader would see as text: a dollar or a \\command outside math and code."""
+    prose = html.unescape(re.sub(r"<[^>]+>", " ", NOT_PROSE.sub(" ", page_html)))
+    return [prose[max(0, m.start() - 30):m.end() + 30] for m in RAW_TEX.finditer(prose)]
+
+
+def test_no_raw_tex_outside_math_and_code(pages):
+    found = {path.name: raw_tex(path.read_text(encoding="utf-8"))[:2] for path in pages}
+    assert {name: tex for name, tex in found.items() if tex} == {}
+    text = (next(p for p in pages if p.name == "08_methods_compared.html")).read_text(
+        encoding="utf-8")
+    assert "(Buss &amp; Kim write" in NOT_PROSE.sub("", text)  # prose stays prose, not math
+
+
+def test_the_raw_tex_check_finds_tex_in_prose():
+    page = ('<p>keep <span class="math notranslate nohighlight">\\(\\lambda\\)</span> and '
+            '<code>$HOME</code></p><p>but $x = \\frac{1}{2}$ shows</p>')
+    assert len(raw_tex(page)) == 3
+
+
 def test_every_image_has_alt_text(pages):
     for path, page in pages.items():
         for image in page.images:
@@ -131,6 +157,24 @@ def test_every_internal_link_and_asset_resolves(site, pages):
             assert target.exists(), f"{path.relative_to(site)}: {url}"
             if parts.fragment and target.suffix == ".html" and target in ids:
                 assert unquote(parts.fragment) in ids[target], f"{path.relative_to(site)}: {url}"
+
+
+def test_the_published_folder_holds_no_cache_and_no_path_of_this_machine(site):
+    names = {p.name for p in site.rglob("*")}
+    assert not names & {".doctrees", ".buildinfo", "environment.pickle", "_sources"}
+    assert not list(site.rglob("*.pickle")) and not list(site.rglob("*.doctree"))
+    here = [str(ROOT).encode(), str(site.parent).encode()]  # the clone, the build folder
+    assert [p for p in site.rglob("*") if p.is_file() and any(h in p.read_bytes() for h in here)] == []
+
+
+def test_the_book_links_every_deck(site, pages):
+    index = pages[site / "index.html"]
+    for path in book.lectures(ROOT):
+        deck = f"slides/{path.stem}.slides.html"
+        assert deck in index.links and (site / deck).is_file(), deck
+        lecture = pages[site / "notebooks" / f"{path.stem}.html"]
+        assert f"../{deck}" in lecture.links, path.name
+    assert "slides/index.html" in index.links and (site / "slides" / "index.html").is_file()
 
 
 def test_the_theme_loads_nothing_from_another_site(site, pages):
@@ -173,6 +217,29 @@ def test_home_page_has_a_picture_and_a_line_per_lecture(site, pages):
         assert re.sub(r"\s+", " ", line.replace("`", ""))[:40] in re.sub(r"\s+", " ", text)
 
 
+def test_the_home_page_shows_one_column_of_the_lectures_table():
+    lines = book.lecture_lines(ROOT)
+    assert len(lines) == len(book.lectures(ROOT))
+    for name, line in lines.items():
+        assert " | " not in line and "core/" not in line, f"{name}: {line}"
+
+
+def test_the_notation_table_shows_subscripts_as_written(site):
+    text = page_text(site / "notation.html")
+    assert "A⁺_λ, J⁺_{1,λ}" in text and "[J]_{ri}, J_{:,i}" in text
+    assert "<em>" not in re.sub(r"(?s).*<main|</main>.*", "", (site / "notation.html").read_text(encoding="utf-8"))
+
+
+def test_each_animation_is_shown_once_with_a_named_slider(site):
+    for path in book.lectures(ROOT):
+        text = (site / "notebooks" / f"{path.stem}.html").read_text(encoding="utf-8")
+        players = text.count('<div class="animation">')
+        sliders = re.findall(r'<input\b[^>]*type="range"[^>]*>', text)
+        assert len(sliders) == players and all('aria-label="' in s for s in sliders), path.name
+        if players:
+            assert "Still frame of an animation" not in text, path.name
+
+
 def test_headings_go_down_one_level_at_a_time(pages):
     for path, page in pages.items():
         levels = [int(h[1]) for h in re.findall(r"<(h[1-6])[ >]", path.read_text(encoding="utf-8"))]
@@ -196,3 +263,13 @@ def test_a_missing_repository_says_what_to_set(tmp_path):
     (tmp_path / "pyproject.toml").write_text('[project]\nname = "ikteach"\n')
     with pytest.raises(SystemExit, match=r"\[project.urls\] Repository"):
         book.stage(tmp_path, tmp_path / "src")
+
+
+def test_the_site_group_is_the_site_extra():
+    """make site installs the `site` dependency group; `ikteach[site]` (in dev) the extra."""
+    import tomllib
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    extra = project["project"]["optional-dependencies"]["site"]
+    assert sorted(project["dependency-groups"]["site"]) == sorted(extra)
+    assert not any(re.match(r"(jax|jupyterlab|ikteach)\b", dep) for dep in extra)

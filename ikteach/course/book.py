@@ -2,7 +2,7 @@
 
     python -m ikteach.course.book [--out build/site]
 
-Stages a Sphinx source folder (build/book-src) from what is committed, then runs Sphinx with
+Stages a Sphinx source folder (build/site-src) from what is committed, then runs Sphinx with
 myst-nb and sphinx-book-theme (docs/conf.py) into build/site:
 
 - the lecture notebooks and the exercise templates, as committed: never re-executed (the outputs
@@ -10,7 +10,12 @@ myst-nb and sphinx-book-theme (docs/conf.py) into build/site:
 - a home page (what the course teaches, one line and a picture per lecture), the notation table
   of notebooks/README.md, and the guides of docs/ (students, lecturers, maintainers);
 - MathJax from the npm package (node_modules, `make node_modules`), copied into the site: the
-  book opens from disk with no network (a lecture hall).
+  book opens from disk with no network (a lecture hall);
+- the lectures' slides (ikteach.course.slides) in build/site/slides, linked from the home page
+  and from each lecture's page.
+
+The published folder holds pages and assets only: Sphinx's caches (.doctrees, .buildinfo)
+are kept outside it (build/site-cache; the staged sources in build/site-src).
 
 The staged copies (never the committed files) get a line of links at the top: "Open in Colab",
 "Binder" and "download the notebook", from the course's home in pyproject.toml. A relative link
@@ -18,6 +23,7 @@ to a file of the repository that is not a page of the book points at the reposit
 """
 import argparse
 import base64
+import copy
 import html
 import json
 import os
@@ -28,9 +34,12 @@ import sys
 import time
 from pathlib import Path
 
-from .course_home import ROOT, home
+if __package__:
+    from .course_home import ROOT, home
+else:  # run as a file: `make site` from the light site venv (no JAX: see the Makefile)
+    from course_home import ROOT, home
 
-STAGE = ROOT / "build" / "book-src"
+STAGE = ROOT / "build" / "site-src"  # beside(OUT, "src")
 OUT = ROOT / "build" / "site"
 MATHJAX = ROOT / "node_modules" / "mathjax" / "es5"
 MATHJAX_FILES = ("tex-svg-full.js", "a11y", "ui", "sre", "adaptors")  # what the page may load
@@ -40,6 +49,9 @@ LINK = re.compile(r"(\]\()([^)\s]+)(\))")
 DATA_IMG = re.compile(r"<img\b[^>]*>")
 WIDGET = "application/vnd.jupyter.widget-view+json"
 STILL = "(a still: run the notebook"  # the caption of a widget's still (pictures/stills.py)
+ANIMATION_STILL = '<img alt="Still frame of an animation.'  # pictures/frames.py show()
+PLAYER = '<div class="animation">'  # matplotlib's JavaScript player
+UNNAMED_SLIDER = re.compile(r'(<input\b(?![^>]*\baria-label=)[^>]*class="anim-slider")')
 
 
 def lectures(root=ROOT):
@@ -108,15 +120,45 @@ def has_widgets(book):
     return False
 
 
+def deck(repo_path):
+    """The book path of a lecture's slides, or None (exercises have none)."""
+    path = Path(repo_path)
+    return f"slides/{path.stem}.slides.html" if path.parent.as_posix() == "notebooks" else None
+
+
 def launch_cell(repo_path, h, widgets):
-    """The Markdown cell put under a page's title: Colab, Binder, the notebook's download."""
+    """The Markdown cell put under a page's title: Colab, Binder, the notebook's download and,
+    for a lecture, its slides."""
     original = os.path.relpath(f"{ORIGINALS}/{repo_path}", Path(repo_path).parent)
     text = (f"[Open in Colab]({h.colab_url(repo_path)}) · [Binder]({h.binder_url(repo_path)}) · "
             f"{{download}}`download the notebook <{original}>`")
+    if deck(repo_path):
+        text += f" · <a href=\"../{deck(repo_path)}\">the slides</a>"
     if widgets:
         text += ("\n\n*This page shows the interactive widgets as still pictures; the live "
                  "version needs a kernel: open the notebook on Colab, Binder or your laptop.*")
     return {"cell_type": "markdown", "metadata": {}, "source": text}
+
+
+def _html(output):
+    return "".join(output.get("data", {}).get("text/html", ""))
+
+
+def one_animation(outputs):
+    """A cell's outputs with each animation shown once: the still frame that pictures.frames.show
+    puts before its player is left out (the player shows that frame first), and the player's
+    frame slider gets a name (matplotlib's has none: axe's `label`)."""
+    kept = []
+    for i, out in enumerate(outputs):
+        later = "".join(_html(o) for o in outputs[i + 1:i + 2])
+        if _html(out).lstrip().startswith(ANIMATION_STILL) and PLAYER in later:
+            continue
+        if PLAYER in _html(out):
+            out = copy.deepcopy(out)
+            out["data"]["text/html"] = UNNAMED_SLIDER.sub(
+                r'\1 aria-label="Animation frame"', _html(out))
+        kept.append(out)
+    return kept
 
 
 def stage_notebook(src, root, h, mapping):
@@ -126,6 +168,8 @@ def stage_notebook(src, root, h, mapping):
     for cell in book["cells"]:
         if cell["cell_type"] == "markdown":
             cell["source"] = rewrite_links(_source(cell), repo_path, h, mapping)
+        elif cell.get("outputs"):
+            cell["outputs"] = one_animation(cell["outputs"])
     first = next(i for i, c in enumerate(book["cells"]) if c["cell_type"] == "markdown")
     book["cells"].insert(first + 1, launch_cell(repo_path, h, has_widgets(book)))
     for cell in book["cells"]:
@@ -154,7 +198,7 @@ def first_picture(book):
 def lecture_lines(root=ROOT):
     """{notebook name: what it derives and checks}: the rows of notebooks/README.md's table."""
     text = (Path(root) / "notebooks" / "README.md").read_text(encoding="utf-8")
-    rows = re.findall(r"^\|\s*`(\d\d_[\w-]+\.ipynb)`[^|]*\|\s*(.+?)\s*\|\s*$", text, re.M)
+    rows = re.findall(r"^\|\s*`(\d\d_[\w-]+\.ipynb)`[^|]*\|\s*((?:\\\||[^|])+?)\s*\|", text, re.M)
     return {name: line.replace("\\|", "|") for name, line in rows}
 
 
@@ -172,11 +216,13 @@ def home_page(root, h, thumbs):
            "[students' guide](guides/students.md).", "", "## Lectures", ""]
     for path in lectures(root):
         book = json.loads(path.read_text(encoding="utf-8"))
-        out += [f"### [{title(book)}](notebooks/{path.name})", ""]
+        out += [f"### [{title(book)}](notebooks/{path.name})", "",
+                f'<a href="{deck(f"notebooks/{path.name}")}">Slides</a> for the lecture hall.', ""]
         if path.stem in thumbs:
             out += [f"![{thumbs[path.stem]}](_static/thumbs/{path.stem}.png)", ""]
         out += [lines.get(path.name, ""), ""]
-    out += ["## Exercises", ""]
+    out += ["Every deck: <a href=\"slides/index.html\">the slides</a> (reveal.js, offline; "
+            "<kbd>F</kbd> full screen, <kbd>S</kbd> the speaker's notes).", "", "## Exercises", ""]
     for path in exercises(root):
         book = json.loads(path.read_text(encoding="utf-8"))
         out.append(f"- [{title(book)}](notebooks/exercises/{path.name})")
@@ -191,13 +237,24 @@ def toctree(caption, entries):
     return "\n".join(["```{toctree}", ":hidden:", f":caption: {caption}", "", *entries, "```", ""])
 
 
+KEEP_AS_IS = re.compile(r"(`[^`\n]*`|\]\([^)\n]*\)|</?[a-zA-Z][^>\n]*>)")  # code, a link's target, a tag
+
+
+def literal_underscores(text):
+    """Markdown text whose underscores show as written (A⁺_λ, J⁺_{1,λ}), not as emphasis;
+    code spans, link targets and HTML tags are left alone."""
+    parts = KEEP_AS_IS.split(text)
+    return "".join(part if i % 2 else re.sub(r"(?<!\\)_", r"\\_", part)
+                   for i, part in enumerate(parts))
+
+
 def notation_page(root, h, mapping):
-    """notation.md: the notation section of notebooks/README.md."""
+    """notation.md: the notation section of notebooks/README.md, symbols as written."""
     text = (Path(root) / "notebooks" / "README.md").read_text(encoding="utf-8")
     start = text.index('<a id="notation"></a>')
     section = text[start:].split("\n", 1)[1]
     section = re.sub(r"^## Notation.*$", "# Notation", section, count=1, flags=re.M)
-    return rewrite_links(section, "notebooks/README.md", h, mapping)
+    return literal_underscores(rewrite_links(section, "notebooks/README.md", h, mapping))
 
 
 def copy_mathjax(static):
@@ -245,36 +302,88 @@ def stage(root=ROOT, dest=STAGE):
             rewrite_links(text, f"docs/{guide}.md", h, mapping), encoding="utf-8")
     (dest / "notation.md").write_text(notation_page(root, h, mapping), encoding="utf-8")
     (dest / "index.md").write_text(home_page(root, h, thumbs), encoding="utf-8")
-    for name in ("book.css", "book.js"):
+    for name in ("book.css", "book.js", "favicon.svg"):
         shutil.copy2(root / "docs" / name, dest / "_static" / name)
     shutil.copy2(root / "docs" / "conf.py", dest / "conf.py")
+    (dest / "course_home.json").write_text(json.dumps(
+        {"repository": h.repository, "branch": h.branch}), encoding="utf-8")
     copy_mathjax(dest / "_static")
     return dest
 
 
-def build(out=OUT, root=ROOT, quiet=True):
-    """Stage and run Sphinx (docs/conf.py); returns the output folder."""
-    src = stage(root)
+def beside(out, what):
+    """A working folder next to the output folder (build/site -> build/site-src): builds into
+    different folders never share one."""
+    return Path(out).parent / f"{Path(out).name}-{what}"
+
+
+def sphinx(src, out, builder="html", quiet=True):
+    """Run Sphinx on the staged folder; its caches (doctrees) go beside out, never into it."""
     shutil.rmtree(out, ignore_errors=True)  # nothing left over from an earlier build
-    cmd = [sys.executable, "-m", "sphinx", "-b", "html",
-           "-j", "auto", "-E", str(src), str(out)] + (["-q"] if quiet else [])
+    cmd = [sys.executable, "-m", "sphinx", "-b", builder, "-j", "auto", "-E",
+           "-d", str(beside(out, "cache")), str(src), str(out)] + (["-q"] if quiet else [])
     subprocess.run(cmd, check=True)
+    (Path(out) / ".buildinfo").unlink(missing_ok=True)  # the config's hash, nothing to read
+    if (Path(out) / "_sources").is_dir() and not any((Path(out) / "_sources").iterdir()):
+        (Path(out) / "_sources").rmdir()  # html_copy_source = False leaves it empty
     return Path(out)
+
+
+def build(out=OUT, root=ROOT, quiet=True):
+    """Stage and run Sphinx (docs/conf.py), then the lectures' slides into out/slides;
+    returns the output folder."""
+    if __package__:
+        from . import slides
+    else:
+        import slides
+    out = sphinx(stage(root, beside(out, "src")), out, quiet=quiet)
+    slides.build(lectures(root), out / "slides")
+    return out
+
+
+PDF = ROOT / "build" / "book.pdf"
+CHROMIUM = "/usr/bin/chromium"  # Debian's, as the browser tests use (make test-browser)
+
+
+def pdf(out=PDF, root=ROOT, chromium=CHROMIUM, quiet=True):
+    """One PDF of the whole book: Sphinx's singlehtml builder (every page on one page), printed by
+    headless Chromium once MathJax has typeset it (no LaTeX). Returns the PDF's path."""
+    if not Path(chromium).is_file():
+        raise SystemExit(f"pdf: no Chromium at {chromium}: `make pdf` installs Debian's chromium")
+    single = ROOT / "build" / "book-single"
+    single = sphinx(stage(root, beside(single, "src")), single, builder="singlehtml", quiet=quiet)
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    subprocess.run([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
+                    "--disable-background-networking", "--no-pdf-header-footer",
+                    "--virtual-time-budget=600000", "--run-all-compositor-stages-before-draw",
+                    f"--print-to-pdf={out}", (single / "index.html").as_uri()],
+                   check=True, capture_output=quiet)
+    return out
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="ikteach site", description=__doc__.split("\n")[0])
     parser.add_argument("--out", type=Path, default=OUT, help="output folder (build/site)")
+    parser.add_argument("--pdf", action="store_true",
+                        help="one PDF of the book instead (build/book.pdf; needs Chromium)")
     args = parser.parse_args(argv)
     start = time.perf_counter()
+    if args.pdf:
+        path = pdf()
+        print(f"pdf: {path} ({path.stat().st_size / 1e6:.1f} MB, "
+              f"{time.perf_counter() - start:.0f} s)")
+        return 0
     try:
         out = build(args.out)
     except subprocess.CalledProcessError as exc:
         print(f"site: sphinx-build failed (exit status {exc.returncode})", file=sys.stderr)
         return 1
-    pages_built = len(list(out.rglob("*.html"))) - len(list((out / "_static").rglob("*.html")))
-    print(f"site: {pages_built} pages in {out} ({time.perf_counter() - start:.0f} s); "
-          f"open {out / 'index.html'}")
+    pages_built = len([p for p in out.rglob("*.html")
+                       if p.relative_to(out).parts[0] not in ("_static", "slides")])
+    decks = len(list((out / "slides").glob("*.slides.html")))
+    print(f"site: {pages_built} pages and {decks} decks in {out} "
+          f"({time.perf_counter() - start:.0f} s); open {out / 'index.html'}")
     return 0
 
 

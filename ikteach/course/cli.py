@@ -3,8 +3,8 @@
     ikteach grade SUBMISSIONS --out grades.csv [options]   grade a class (python -m ikteach.course.grade)
     ikteach exercises build                                 templates from the solutions
     ikteach site [--out build/site]                         the course as a static book
-    ikteach slides [--out build/slides] [NOTEBOOK ...]      reveal.js decks of the lectures
-    ikteach header [--check]                                Colab cells and badges from pyproject.toml
+    ikteach slides [--out build/site/slides] [NOTEBOOK ...] reveal.js decks of the lectures
+    ikteach header [--check] [--ref TAG]                    Colab cells and badges from pyproject.toml
     ikteach warm [NOTEBOOK ...] [--cache DIR]               compile the lectures' solvers before class
 
 The names stay when the modules behind them move: a lecturer's script calls `ikteach grade`,
@@ -18,7 +18,7 @@ COMMANDS = {
     "grade": ("ikteach.course.grade", "grade the students' exercise notebooks into a CSV"),
     "exercises": ("ikteach.course.exercises", "`exercises build`: the templates from the solutions"),
     "site": ("ikteach.course.book", "build the course as a static HTML book (build/site)"),
-    "slides": ("ikteach.course.slides", "build reveal.js slides of the lectures (build/slides)"),
+    "slides": ("ikteach.course.slides", "build reveal.js slides of the lectures (build/site/slides)"),
     "header": ("ikteach.course.notebook_header", "write the Colab cells and badges (make header)"),
     "warm": ("ikteach.course.warm", "compile every lecture's solvers into the cache, before class"),
 }

@@ -51,6 +51,26 @@ class Home:
                 f"[![Binder]({BINDER_BADGE})]({self.binder_url(path)})")
 
 
+BRANCH_LINE = re.compile(r'^(branch\s*=\s*)"[^"]*"', re.M)
+REF = re.compile(r"[A-Za-z0-9][\w.-]*(/[\w.-]+)*")
+
+
+def with_branch(text, ref):
+    """pyproject.toml's text with [tool.ikteach] branch set to ref: a branch or a tag (a term's
+    release, e.g. "v2026.1"), which Colab then installs from and the badges open."""
+    if not REF.fullmatch(ref or "") or ".." in ref or ref.endswith((".", ".lock")):
+        raise ValueError(f"ref: expected a git branch or tag name such as main or v2026.1, got {ref!r}")
+    start = text.find("[tool.ikteach]")
+    if start < 0:
+        raise ValueError("pyproject.toml: expected a [tool.ikteach] table with branch = \"...\"")
+    end = text.find("\n[", start + 1)
+    table = text[start:end if end >= 0 else len(text)]
+    if not BRANCH_LINE.search(table):
+        raise ValueError("pyproject.toml: expected branch = \"...\" under [tool.ikteach]")
+    new = BRANCH_LINE.sub(lambda m: f'{m.group(1)}"{ref}"', table, count=1)
+    return text[:start] + new + text[start + len(table):]
+
+
 def home(pyproject=ROOT / "pyproject.toml"):
     """The Home named by a pyproject.toml."""
     data = tomllib.loads(Path(pyproject).read_text(encoding="utf-8"))

@@ -2,6 +2,11 @@
 
     python -m ikteach.course.notebook_header          # rewrite what is out of date (make header)
     python -m ikteach.course.notebook_header --check  # exit 1 and name what is out of date
+    python -m ikteach.course.notebook_header --ref v2026.1  # links for a term's release tag
+
+--ref sets [tool.ikteach] branch in pyproject.toml first (a branch or a tag): Colab then
+installs the course from that ref and every badge opens the notebooks as they are there
+(docs/lecturers.md, "A term's release"). `--ref main` goes back.
 
 The first code cell of each notebook (lecture notebooks, exercises, instructor solutions)
 starts with a generated block: on Colab only, pip-install the course package quietly (its
@@ -19,7 +24,7 @@ import re
 import sys
 from pathlib import Path
 
-from .course_home import ROOT, home
+from .course_home import ROOT, home, with_branch
 
 MARKER = "# Course setup, generated from pyproject.toml by `make header`: edit there, not here."
 # A generated block of any home: optional marker, `import sys`, the Colab test, its body.
@@ -167,7 +172,17 @@ def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m ikteach.notebook_header",
                                      description=__doc__.split("\n")[0])
     parser.add_argument("--check", action="store_true", help="only report, exit 1 if stale")
+    parser.add_argument("--ref", help="set the branch or tag the links point at (pyproject.toml)")
     args = parser.parse_args(argv)
+    if args.ref is not None:
+        if args.check:
+            parser.error("--ref writes pyproject.toml: not with --check")
+        pyproject = ROOT / "pyproject.toml"
+        try:
+            pyproject.write_text(with_branch(pyproject.read_text(encoding="utf-8"), args.ref),
+                                 encoding="utf-8")
+        except ValueError as exc:
+            parser.error(str(exc))
     stale = update(write=not args.check)
     for path in stale:
         print(f"{'out of date' if args.check else 'updated'}: {path.relative_to(ROOT)}")

@@ -176,11 +176,16 @@ def _icon_svg(path):
             f'style="vertical-align:middle"><path fill="currentColor" d="{path}"/></svg>')
 
 
+_UNNAMED_SLIDER = re.compile(r'(<input\b(?![^>]*\baria-label=)[^>]*class="anim-slider")')
+
+
 def offline(page):
     """matplotlib's animation HTML without its font-awesome stylesheet from a CDN: every
-    button icon an inline SVG, so the page plays with its buttons drawn with no network.
+    button icon an inline SVG, so the page plays with its buttons drawn with no network; its
+    frame slider named for screen readers ("Animation frame": matplotlib's has no name).
     An icon or an outside URL this does not know is a ValueError (a new matplotlib's player)."""
     page = _CDN_STYLESHEET.sub("", page)
+    page = _UNNAMED_SLIDER.sub(r'\1 aria-label="Animation frame"', page)
     for name, path in _ICON_PATHS.items():
         page = page.replace(f'<i class="{name}"></i>', _icon_svg(path))
     left = re.findall(r'<i class="fa[^"]*"></i>|https?://[^\s"\'<>]+', page)

@@ -68,8 +68,21 @@ def _run_all(lab, browser):
 PICTURE = ".widget-html svg[role=img]"  # the demo's picture (an SVG in an HTML widget)
 
 
-def _demo(driver):
-    """The demo's box, picture, status line and x slider handle, scrolled to the top."""
+def _demo(driver, attempts=3):
+    """The demo's box, picture, status line and x slider handle, scrolled to the top; found
+    again when the widget redraws while they are looked up (a stale element)."""
+    from selenium.common.exceptions import StaleElementReferenceException
+
+    for attempt in range(attempts):
+        try:
+            return _find_demo(driver)
+        except StaleElementReferenceException:
+            if attempt == attempts - 1:
+                raise
+            time.sleep(1.0)
+
+
+def _find_demo(driver):
     try:
         image = _wait_until(lambda: driver.find_elements(By.CSS_SELECTOR, PICTURE), 60,
                             "the demo widget")[0]

@@ -39,9 +39,16 @@ def free_port():
 
 
 def wait_until(condition, timeout, what, every=0.25):
+    """condition()'s first true value within timeout seconds; an element re-rendered while the
+    condition read it (a widget redrawn) counts as not yet."""
+    from selenium.common.exceptions import StaleElementReferenceException
+
     end = time.monotonic() + timeout
     while time.monotonic() < end:
-        value = condition()
+        try:
+            value = condition()
+        except StaleElementReferenceException:
+            value = None
         if value:
             return value
         time.sleep(every)

@@ -1,59 +1,94 @@
-"""The book (make site) as a reader sees it: headless Chromium opens the home page, lecture 04
-and an exercise from file:// (no server, no network needed), with no console error, the math
-rendered by the site's own MathJax, and no serious or critical accessibility violation found by
-axe-core (npm, node_modules/axe-core). The decks of `make slides` too: lecture 04's deck opens
-with no console error and its slides fit 1280x720. Screenshots (1280x720) go to
-$BROWSER_SHOTS (default /tmp/ikteach-browser)."""
+"""The book (make site) as a reader sees it, in headless Chromium from file:// (no server, no
+network): every page at a phone's width (375 px) and a laptop's (1280 px) with its math typeset
+(no raw TeX, no MathJax error), no console error, no serious or critical accessibility violation
+found by axe-core (npm, node_modules/axe-core) and nothing wider than the screen; the menu and
+the page's contents open at 375, 768 and 1280 px; search finds pages with no console error from
+disk, and with snippets when served. Screenshots go to $BROWSER_SHOTS (default
+/tmp/ikteach-browser). The decks are tests/browser/site_slides.py.
+
+`-m smoke` (CI, .ci/run) keeps the per-page checks and the menus."""
+import http.server
 import os
+import threading
 import time
+from functools import partial
 from pathlib import Path
 
 import pytest
 
 from labdriver import chromium, wait_until
 
-from ikteach.course import book, slides
-
 ROOT = Path(__file__).resolve().parents[2]
 AXE = ROOT / "node_modules" / "axe-core" / "axe.min.js"
 SHOTS = Path(os.environ.get("BROWSER_SHOTS", "/tmp/ikteach-browser"))
-LECTURE = "notebooks/04_damped_least_squares.html"
-EXERCISE = "notebooks/exercises/04_dls_step.html"
+WIDTHS = {"phone": (375, 812), "tablet": (768, 1024), "laptop": (1280, 720)}
+SHOT_PAGES = {"index.html": "home", "notebooks/04_damped_least_squares.html": "04",
+              "notebooks/08_methods_compared.html": "08",
+              "notebooks/exercises/04_dls_step.html": "exercise-04"}
+
+# TeX left as text: a $ or a \command in what the page shows, outside typeset math and code.
+RAW_TEX = """
+const skip = "mjx-container, pre, code, script, style, textarea, .MathJax";
+const walker = document.createTreeWalker(document.querySelector("main") || document.body,
+                                         NodeFilter.SHOW_TEXT);
+const found = [];
+for (let node = walker.nextNode(); node; node = walker.nextNode()) {
+  const parent = node.parentElement;
+  if (!parent || parent.closest(skip) || !parent.getClientRects().length) continue;
+  const match = node.textContent.match(/.{0,30}(\\$|\\\\[a-zA-Z]+).{0,30}/);
+  if (match) found.push(match[0]);
+}
+return found;"""
 
 
-@pytest.fixture(scope="module")
-def site(tmp_path_factory):
-    return book.build(tmp_path_factory.mktemp("book") / "site")
+def site_pages(site):
+    return sorted(p.relative_to(site).as_posix() for p in site.rglob("*.html")
+                  if not {"_static", "slides"} & set(p.relative_to(site).parts))
 
 
 @pytest.fixture(scope="module")
 def driver():
     with chromium() as d:
-        d.execute_cdp_cmd("Emulation.setDeviceMetricsOverride",
-                          {"width": 1280, "height": 720, "deviceScaleFactor": 1, "mobile": False})
         yield d
 
 
-def open_page(driver, path):
+def use_width(driver, name):
+    width, height = WIDTHS[name]
+    driver.execute_cdp_cmd("Emulation.setDeviceMetricsOverride",
+                           {"width": width, "height": height, "deviceScaleFactor": 1,
+                            "mobile": width < 500})
+
+
+def open_page(driver, url):
     driver.get_log("browser")  # forget what earlier pages said
-    driver.get(path.resolve().as_uri())
+    driver.get(url)
     wait_until(lambda: driver.execute_script("return document.readyState") == "complete",
-               30, f"{path.name} loaded")
+               30, f"{url} loaded")
+    if driver.execute_script("return !!(window.MathJax && MathJax.startup)"):  # pages with math
+        wait_until(lambda: driver.execute_script("return !!MathJax.startup.promise"), 30,
+                   "MathJax started")
+        driver.execute_async_script("MathJax.startup.promise.then(arguments[arguments.length - 1])")
 
 
 def console_errors(driver):
     return [entry["message"] for entry in driver.get_log("browser") if entry["level"] == "SEVERE"]
 
 
-def math_rendered(driver):
-    """(formulas typeset by MathJax, formulas it could not read)."""
+def math_errors(driver):
     return driver.execute_script(
-        "return [document.querySelectorAll('mjx-container svg').length,"
-        " document.querySelectorAll('mjx-merror, [data-mjx-error]').length]")
+        "return [...document.querySelectorAll('mjx-merror, [data-mjx-error]')]"
+        ".map(e => e.getAttribute('data-mjx-error') || e.textContent)")
+
+
+def overflow(driver):
+    """How many CSS pixels the page is wider than the screen (0: it fits)."""
+    return driver.execute_script(
+        "return Math.max(0, document.documentElement.scrollWidth - window.innerWidth)")
 
 
 def axe_violations(driver):
-    driver.execute_script(AXE.read_text(encoding="utf-8"))
+    if not driver.execute_script("return !!window.axe"):
+        driver.execute_script(AXE.read_text(encoding="utf-8"))
     violations = driver.execute_async_script(
         "const done = arguments[arguments.length - 1];"
         "axe.run(document, {resultTypes: ['violations']}).then(r => done(r.violations));")
@@ -66,62 +101,103 @@ def shoot(driver, name):
     driver.save_screenshot(str(SHOTS / name))
 
 
-@pytest.mark.parametrize("page", ["index.html", LECTURE])
-def test_page_opens_from_disk_with_no_console_error(site, driver, page):
-    open_page(driver, site / page)
-    time.sleep(1)
-    assert console_errors(driver) == []
+@pytest.mark.parametrize("width", [pytest.param("phone", marks=pytest.mark.smoke), "laptop"])
+def test_every_page_reads_right(site, driver, width):
+    """Math typeset, no console error, no serious axe violation, nothing wider than the screen."""
+    use_width(driver, width)
+    problems = []
+    for page in site_pages(site):
+        open_page(driver, (site / page).as_uri())
+        found = {"raw TeX": driver.execute_script(RAW_TEX)[:2],
+                 "MathJax errors": math_errors(driver)[:2],
+                 "console errors": console_errors(driver)[:2],
+                 "axe": axe_violations(driver)[:2],
+                 "wider than the screen by (px)": overflow(driver)}
+        problems += [f"{page} at {width}: {what}: {value}" for what, value in found.items() if value]
+        if page in SHOT_PAGES:
+            shoot(driver, f"site-{SHOT_PAGES[page]}-{width}.png")
+    assert problems == []
 
 
-def test_math_is_rendered_on_lecture_04(site, driver):
-    open_page(driver, site / LECTURE)
-    wait_until(lambda: math_rendered(driver)[0] > 20, 60, "MathJax typeset the page")
-    assert math_rendered(driver)[1] == 0
-    shoot(driver, "site-lecture-04.png")
+def menu_state(driver):
+    """(the site menu dialog open, the contents dialog open, the wide menu hidden)."""
+    return tuple(driver.execute_script(
+        "return [document.querySelector('#pst-primary-sidebar-modal').open,"
+        " document.querySelector('#pst-secondary-sidebar-modal').open,"
+        " document.querySelector('#pst-primary-sidebar').classList.contains('pst-sidebar-hidden')]"))
 
 
-@pytest.mark.parametrize("page", ["index.html", LECTURE])
-def test_no_serious_accessibility_violation(site, driver, page):
-    open_page(driver, site / page)
-    time.sleep(1)
-    if driver.execute_script("return !!(window.MathJax && MathJax.startup)"):  # pages with math
-        driver.execute_async_script("MathJax.startup.promise.then(arguments[arguments.length - 1])")
-    assert axe_violations(driver) == []
+def visible_button(driver, name):
+    from selenium.webdriver.common.by import By
+
+    buttons = [b for b in driver.find_elements(By.CSS_SELECTOR, f"button.{name}") if b.is_displayed()]
+    assert len(buttons) == 1, f"{name}: {len(buttons)} visible buttons"
+    return buttons[0]
 
 
-def test_screenshots_of_home_and_an_exercise(site, driver):
-    open_page(driver, site / "index.html")
-    shoot(driver, "site-home.png")
-    driver.execute_script("document.querySelector('#lectures').scrollIntoView()")
-    shoot(driver, "site-home-lectures.png")
-    open_page(driver, site / EXERCISE)
-    shoot(driver, "site-exercise-04.png")
-    assert console_errors(driver) == []
+@pytest.mark.smoke
+@pytest.mark.parametrize("width", ["phone", "tablet", "laptop"])
+def test_the_menu_and_the_contents_open(site, driver, width):
+    from selenium.webdriver.common.keys import Keys
+
+    use_width(driver, width)
+    open_page(driver, (site / "notebooks" / "04_damped_least_squares.html").as_uri())
+    visible_button(driver, "primary-toggle").click()
+    time.sleep(0.5)
+    if width == "laptop":  # the menu is a column: the button hides it, and shows it again
+        assert menu_state(driver) == (False, False, True)
+        visible_button(driver, "primary-toggle").click()
+        time.sleep(0.5)
+        assert menu_state(driver) == (False, False, False)
+        assert driver.execute_script(  # the contents column is there, nothing in it cut off
+            "const toc = document.querySelector('#pst-secondary-sidebar');"
+            "const box = toc.getBoundingClientRect();"
+            "const inside = [...toc.querySelectorAll('*')].every(e => e.closest('mjx-assistive-mml')"
+            "  || e.getBoundingClientRect().right <= box.right + 1);"  # (MathML for screen readers)
+            "return box.width > 100 && box.right <= window.innerWidth + 1 && inside")
+        return
+    assert menu_state(driver)[0], "the site menu did not open"
+    shoot(driver, f"site-menu-{width}.png")
+    assert "Damped least squares" in driver.execute_script(
+        "return document.querySelector('#pst-primary-sidebar-modal').innerText")
+    driver.switch_to.active_element.send_keys(Keys.ESCAPE)
+    wait_until(lambda: not any(menu_state(driver)), 5, "the menu to close")
+    visible_button(driver, "secondary-toggle").click()
+    time.sleep(0.5)
+    assert menu_state(driver)[1], "the page's contents did not open"
+    assert driver.execute_script(
+        "return document.querySelector('#pst-secondary-sidebar-modal a[href^=\"#\"]') !== null")
+    shoot(driver, f"site-contents-{width}.png")
 
 
-def test_lecture_04_slides_fit_and_load_nothing_else(tmp_path, driver):
-    deck, = slides.build([ROOT / "notebooks" / "04_damped_least_squares.ipynb"], tmp_path)
-    open_page(driver, deck)
-    wait_until(lambda: driver.execute_script("return !!window.Reveal && Reveal.isReady()"),
-               30, "reveal.js ready")
-    driver.execute_script("Reveal.configure({transition: 'none'})")  # measure still slides
-    off_screen = []
-    for number, where in enumerate(driver.execute_script(
-            "return Reveal.getSlides().map(s => Reveal.getIndices(s))")):
-        h, v = where["h"], where["v"] or 0
-        driver.execute_script(f"Reveal.slide({h}, {v});"
-                              "Reveal.getCurrentSlide().querySelectorAll('.fragment')"
-                              ".forEach(f => f.classList.add('visible'));")
-        time.sleep(0.3)
-        if (h, v) in [(1, 0), (2, 1), (4, 1)]:
-            shoot(driver, f"slides-04-{h}-{v}.png")
-        # every part of the slide, all fragments shown, is inside the 1280 x 720 window
-        bottom, right = driver.execute_script(
-            "let low = 0, far = 0; Reveal.getCurrentSlide().querySelectorAll('*').forEach(e => {"
-            " const box = e.getBoundingClientRect();"
-            " if (box.height) { low = Math.max(low, box.bottom); far = Math.max(far, box.right); }"
-            "}); return [low, far];")
-        if bottom > 722 or right > 1282:
-            off_screen.append(f"slide {h}/{v}: ends at ({right:.0f}, {bottom:.0f}) px")
-    assert number > 10 and off_screen == []
-    assert console_errors(driver) == []
+def search_results(driver, url):
+    open_page(driver, url)
+    wait_until(lambda: driver.execute_script(
+        "return document.querySelectorAll('#search-results li').length"), 30, "search results")
+    time.sleep(1)  # snippets, where they are fetched, arrive after the titles
+    return driver.execute_script(
+        "return [...document.querySelectorAll('#search-results li')]"
+        ".map(li => li.querySelector('p.context') ? li.innerText : '')")
+
+
+def test_search_from_disk_finds_pages_without_console_errors(site, driver):
+    use_width(driver, "laptop")
+    results = search_results(driver, (site / "search.html").as_uri() + "?q=damping")
+    assert len(results) >= 3 and console_errors(driver) == []
+
+
+def test_search_on_a_served_site_shows_snippets(site, driver):
+    class Quiet(http.server.SimpleHTTPRequestHandler):
+        def log_message(self, *args):
+            pass
+
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), partial(Quiet, directory=str(site)))
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    try:
+        use_width(driver, "laptop")
+        url = f"http://127.0.0.1:{server.server_address[1]}/search.html?q=damping"
+        results = search_results(driver, url)
+        assert sum(bool(r) for r in results) >= 3, results
+        assert console_errors(driver) == []
+    finally:
+        server.shutdown()
