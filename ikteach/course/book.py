@@ -23,7 +23,6 @@ to a file of the repository that is not a page of the book points at the reposit
 """
 import argparse
 import base64
-import copy
 import html
 import json
 import os
@@ -36,8 +35,12 @@ from pathlib import Path
 
 if __package__:
     from .course_home import ROOT, home
+    from .notebook_html import (ANIMATION_STILL, PLAYER, STILL, WIDGET, _source,  # noqa: F401
+                                one_animation, rewrite_links, title)
 else:  # run as a file: `make site` from the light site venv (no JAX: see the Makefile)
     from course_home import ROOT, home
+    from notebook_html import (ANIMATION_STILL, PLAYER, STILL, WIDGET, _source,  # noqa: F401
+                               one_animation, rewrite_links, title)
 
 STAGE = ROOT / "build" / "site-src"  # beside(OUT, "src")
 OUT = ROOT / "build" / "site"
@@ -45,13 +48,7 @@ MATHJAX = ROOT / "node_modules" / "mathjax" / "es5"
 MATHJAX_FILES = ("tex-svg-full.js", "a11y", "ui", "sre", "adaptors")  # what the page may load
 ORIGINALS = "_notebooks"  # the committed notebooks as they are, for "download the notebook"
 GUIDES = ("students", "lecturers", "maintainers")
-LINK = re.compile(r"(\]\()([^)\s]+)(\))")
 DATA_IMG = re.compile(r"<img\b[^>]*>")
-WIDGET = "application/vnd.jupyter.widget-view+json"
-STILL = "(a still: run the notebook"  # the caption of a widget's still (pictures/stills.py)
-ANIMATION_STILL = '<img alt="Still frame of an animation.'  # pictures/frames.py show()
-PLAYER = '<div class="animation">'  # matplotlib's JavaScript player
-UNNAMED_SLIDER = re.compile(r'(<input\b(?![^>]*\baria-label=)[^>]*class="anim-slider")')
 
 
 def lectures(root=ROOT):
@@ -60,21 +57,6 @@ def lectures(root=ROOT):
 
 def exercises(root=ROOT):
     return sorted((Path(root) / "notebooks" / "exercises").glob("*.ipynb"))
-
-
-def _source(cell):
-    source = cell.get("source", "")
-    return "".join(source) if isinstance(source, list) else source
-
-
-def title(book):
-    """The notebook's first Markdown heading."""
-    for cell in book["cells"]:
-        if cell["cell_type"] == "markdown":
-            match = re.search(r"^#\s+(.+)$", _source(cell), re.M)
-            if match:
-                return match.group(1).strip()
-    raise ValueError("notebook: expected a '# title' in a Markdown cell")
 
 
 def pages(root=ROOT):
@@ -86,28 +68,6 @@ def pages(root=ROOT):
     mapping["notebooks/README.md"] = "notation.md"
     mapping["README.md"] = "index.md"
     return mapping
-
-
-def rewrite_links(text, repo_path, h, mapping):
-    """Markdown text of the file at repo_path with relative links made right for the book."""
-    book_dir = Path(mapping.get(repo_path, repo_path)).parent
-
-    def fix(match):
-        target = match.group(2)
-        if re.match(r"[a-z]+:|#|/", target):
-            return match.group(0)
-        path, _, anchor = target.partition("#")
-        full = os.path.normpath(Path(repo_path).parent / path).replace(os.sep, "/")
-        if full in mapping:
-            new = os.path.relpath(mapping[full], book_dir).replace(os.sep, "/")
-            if full == "notebooks/README.md":
-                anchor = "notation"
-        else:
-            kind = "tree" if (ROOT / full).is_dir() else "blob"
-            new = f"{h.repository}/{kind}/{h.branch}/{full}"
-        return match.group(1) + new + (f"#{anchor}" if anchor else "") + match.group(3)
-
-    return LINK.sub(fix, text)
 
 
 def has_widgets(book):
@@ -138,27 +98,6 @@ def launch_cell(repo_path, h, widgets):
         text += ("\n\n*This page shows the interactive widgets as still pictures; the live "
                  "version needs a kernel: open the notebook on Colab, Binder or your laptop.*")
     return {"cell_type": "markdown", "metadata": {}, "source": text}
-
-
-def _html(output):
-    return "".join(output.get("data", {}).get("text/html", ""))
-
-
-def one_animation(outputs):
-    """A cell's outputs with each animation shown once: the still frame that pictures.frames.show
-    puts before its player is left out (the player shows that frame first), and the player's
-    frame slider gets a name (matplotlib's has none: axe's `label`)."""
-    kept = []
-    for i, out in enumerate(outputs):
-        later = "".join(_html(o) for o in outputs[i + 1:i + 2])
-        if _html(out).lstrip().startswith(ANIMATION_STILL) and PLAYER in later:
-            continue
-        if PLAYER in _html(out):
-            out = copy.deepcopy(out)
-            out["data"]["text/html"] = UNNAMED_SLIDER.sub(
-                r'\1 aria-label="Animation frame"', _html(out))
-        kept.append(out)
-    return kept
 
 
 def stage_notebook(src, root, h, mapping):

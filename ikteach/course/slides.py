@@ -32,10 +32,10 @@ import sys
 from pathlib import Path
 
 if __package__:
-    from .book import STILL, WIDGET, one_animation, rewrite_links, title
+    from .notebook_html import STILL, WIDGET, one_animation, rewrite_links, title
     from .course_home import ROOT, home
 else:  # run as a file: `make slides` from the light site venv (no JAX: see the Makefile)
-    from book import STILL, WIDGET, one_animation, rewrite_links, title
+    from notebook_html import STILL, WIDGET, one_animation, rewrite_links, title
     from course_home import ROOT, home
 
 

@@ -152,7 +152,9 @@ def serve(namespace, graded, requests, send):
         held = {}
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
-    send({"ready": sorted(k for k, v in namespace.items() if callable(v) and k[:2] != "__"),
+    callables = sorted(k for k, v in namespace.items() if callable(v) and k[:2] != "__")
+    first = [k for k in graded if k in callables]  # the grader keeps MAX_NAMES: graded ones first
+    send({"ready": first + [k for k in callables if k not in first],
           "foreign": own_code.foreign(namespace, graded), "held": held})
     handles = []
     for line in requests:
