@@ -32,12 +32,12 @@ BUDGETS = {
     "02_jacobian_transpose": 29,
     "03_pseudoinverse": 25,
     "04_damped_least_squares": 49,
-    "05_singularities_out_of_reach": 117,
+    "05_singularities_out_of_reach": 136,
     "06_pose_targets_3d": 53,
-    "07_workspace_maps": 11,
-    "08_methods_compared": 28,
+    "07_workspace_maps": 13,
+    "08_methods_compared": 45,
     "09_characters": 27,
-    "10_redundancy": 44,
+    "10_redundancy": 45,
 }
 
 # Run in the kernel before the notebook's first cell: count JAX's own compile events.
