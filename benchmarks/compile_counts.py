@@ -33,7 +33,7 @@ def main():
         with tempfile.TemporaryDirectory(prefix="ikteach-cache-") as cache:
             cold = count_programs(path, cache)
             warm = None if args.cold_only else count_programs(path, cache)
-        budget = BUDGETS.get(path.stem, "-")
+        budget = BUDGETS.get(path.stem, "-") if path.parent.name == "notebooks" else "-"
         warm_s = f"{warm['wall_s']:6.1f}" if warm else "     -"
         loaded = f"{warm['loaded']:6d}" if warm else "     -"
         print(f"| {path.stem:<30} | {cold['programs']:>8} | {budget:>6} | {cold['compile_s']:>9.1f} | "
