@@ -221,10 +221,11 @@ def run_queue(step, start, args, rows, starts):
         size = bucket(count)
         pad = lambda x: _padded(x, size)
         rows, starts = jax.tree_util.tree_map(pad, rows), pad(starts)
-        if in_flight(size) == size and jax.local_devices()[0].platform != "cpu":
+        slots = in_flight(size)
+        if slots == size and jax.local_devices()[0].platform != "cpu":
             state = _run_all(step, start, args, rows, starts, np.int64(count))
         else:
-            state = _run_queue(step, start, args, rows, starts, np.int64(count), in_flight(size))
+            state = _run_queue(step, start, args, rows, starts, np.int64(count), slots)
         return jax.tree_util.tree_map(lambda x: np.asarray(x)[:count], jax.device_get(state))
     d = len(devices)
     share = bucket(-(-count // d))

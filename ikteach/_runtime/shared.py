@@ -22,10 +22,6 @@ class OneOf:
     def __init__(self, index, members):
         self.index, self.members = index, tuple(members)
 
-    @property
-    def chosen(self):
-        return self.members[int(self.index)]
-
     uses_jacobian = property(lambda self: self.members[0].uses_jacobian)
     is_jax = True
 

@@ -36,11 +36,11 @@ from pathlib import Path
 if __package__:
     from .course_home import ROOT, home
     from .notebook_html import (ANIMATION_STILL, PLAYER, STILL, WIDGET, _source,  # noqa: F401
-                                one_animation, rewrite_links, title)
+                                has_still, one_animation, rewrite_links, title)
 else:  # run as a file: `make site` from the light site venv (no JAX: see the Makefile)
     from course_home import ROOT, home
     from notebook_html import (ANIMATION_STILL, PLAYER, STILL, WIDGET, _source,  # noqa: F401
-                               one_animation, rewrite_links, title)
+                               has_still, one_animation, rewrite_links, title)
 
 STAGE = ROOT / "build" / "site-src"  # beside(OUT, "src")
 OUT = ROOT / "build" / "site"
@@ -72,12 +72,7 @@ def pages(root=ROOT):
 
 def has_widgets(book):
     """True when an output is a widget or a widget's still (ikteach.pictures.stills)."""
-    for cell in book["cells"]:
-        for out in cell.get("outputs", []):
-            data = out.get("data", {})
-            if WIDGET in data or STILL in "".join(data.get("text/html", "")):
-                return True
-    return False
+    return any(has_still(cell) for cell in book["cells"])
 
 
 def deck(repo_path):

@@ -74,3 +74,12 @@ def one_animation(outputs):
                 r'\1 aria-label="Animation frame"', _html(out))
         kept.append(out)
     return kept
+
+
+def has_still(cell):
+    """True when an output is a widget or a widget's still (moves only in a kernel)."""
+    for out in cell.get("outputs", []):
+        data = out.get("data", {})
+        if WIDGET in data or STILL in "".join(data.get("text/html", "")):
+            return True
+    return False

@@ -32,10 +32,10 @@ import sys
 from pathlib import Path
 
 if __package__:
-    from .notebook_html import STILL, WIDGET, one_animation, rewrite_links, title
+    from .notebook_html import has_still, one_animation, rewrite_links, title
     from .course_home import ROOT, home
 else:  # run as a file: `make slides` from the light site venv (no JAX: see the Makefile)
-    from notebook_html import STILL, WIDGET, one_animation, rewrite_links, title
+    from notebook_html import has_still, one_animation, rewrite_links, title
     from course_home import ROOT, home
 
 
@@ -196,15 +196,6 @@ def cell_parts(cell):
     if group:
         parts.append(_only_outputs(cell, group))
     return parts
-
-
-def has_still(cell):
-    """True when an output is a widget or a widget's still (moves only in a kernel)."""
-    for out in cell.get("outputs", []):
-        data = out.get("data", {})
-        if WIDGET in data or STILL in "".join(data.get("text/html", "")):
-            return True
-    return False
 
 
 def live_links(repo_path):
