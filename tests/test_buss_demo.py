@@ -46,3 +46,30 @@ def test_clamp_growth_needs_a_clamp_and_a_bool():
         ik.track(tree, targets, clamp_growth=True)
     with pytest.raises(ValueError, match="clamp_growth"):
         ik.track(tree, targets, clamp=0.4, clamp_growth="yes")
+
+
+@pytest.mark.parametrize("label", ["DLS", "SDLS", "DLS + clamp"])
+def test_several_paths_at_once_follow_each_path_as_alone(label):
+    """targets (P, T, ...): every path tracked side by side in one program, each as if alone
+    (the same steps; vectorised arithmetic may round the last bits differently)."""
+    tree, kw = bt.y_tree(), bt.demo_methods("y")[label]
+    paths = np.stack([bt.y_targets(t0 + bt.times(200)) for t0 in (0.0, 10.0, 20.0)])
+    starts = np.random.default_rng(2).uniform(-0.1, 0.1, (3, tree.n_joints))
+    both = ik.track(tree, paths, starts, **kw)
+    assert both.theta.shape == (3, 201, tree.n_joints) and both.error.shape == (3, 200)
+    for path, start, theta, error in zip(paths, starts, both.theta, both.error):
+        alone = ik.track(tree, path, start, **kw)
+        np.testing.assert_allclose(theta, alone.theta, rtol=0, atol=1e-9)
+        np.testing.assert_allclose(error, alone.error, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(both.mean_error, both.error.mean(axis=1))
+    np.testing.assert_allclose(both.jitter, [ik.core.jitter.jitter(q) for q in both.theta])
+    shared = ik.track(tree, paths, starts[0], **kw)  # one start for every path
+    np.testing.assert_array_equal(shared.theta[:, 0], np.broadcast_to(starts[0], (3, tree.n_joints)))
+
+
+def test_paths_of_a_wrong_shape_are_named():
+    tree = bt.y_tree()
+    with pytest.raises(ValueError, match=r"targets: expected shape \(T, \*target\).*\(P, T, \*target\)"):
+        ik.track(tree, np.zeros((2, 5, 3, 3)))
+    with pytest.raises(ValueError, match="theta0"):
+        ik.track(tree, np.zeros((2, 5, 2, 3)), np.zeros((3, tree.n_joints)))

@@ -12,7 +12,8 @@ is a NamedTuple with fields i, theta, error and status; it is running while stat
                target has finished takes the next one (the work is the sum of the iterations,
                not the batch size times the largest count); batches padded to a few sizes
                (bucket) so a new batch size rarely compiles; split over CPU devices when several;
-  run_scan     ik.track: jax.lax.scan of one step per time step, SCAN_CHUNK steps per program;
+  run_scan     ik.track: jax.lax.scan of one step per time step, SCAN_CHUNK steps per program
+               (several paths side by side: jax.vmap of the step);
   until_stopped  the loop as one traceable while_loop, for a caller's own compiled program.
 """
 import functools
@@ -239,24 +240,31 @@ def run_queue(step, start, args, rows, starts):
     return jax.tree_util.tree_map(lambda x: np.asarray(x)[back], state)
 
 
-@partial(runtime_jit.jit, static_argnames=("step",))
-def _scan(step, args, carry, rows):
+@partial(runtime_jit.jit, static_argnames=("step", "paths"))
+def _scan(step, args, carry, rows, paths):
+    advance = jax.vmap(step, in_axes=(None, 0, 0)) if paths else step  # paths: side by side
+
     def one(carry, row):
-        new, out = step(args, carry, row)
+        new, out = advance(args, carry, row)
         return same_types(new, carry), out
     return jax.lax.scan(one, carry, rows)
 
 
-def run_scan(step, args, carry, rows):
+def run_scan(step, args, carry, rows, paths=False):
     """step(args, carry, row) -> (carry, out) over the rows, SCAN_CHUNK rows per compiled run
     (the last chunk padded with copies of the last row, its extra outputs dropped); returns
-    the outputs stacked (numpy)."""
-    count, args = jax.tree_util.tree_leaves(rows)[0].shape[0], as_data(args)
+    the outputs stacked (numpy). paths: rows (P, T, ...) and carry (P, ...) hold P independent
+    runs, stepped side by side in one program (jax.vmap of step); outputs (P, T, ...)."""
+    args = as_data(args)
+    if paths:  # time first: the scan walks the time steps, every path at once
+        rows = jax.tree_util.tree_map(lambda x: np.swapaxes(np.asarray(x), 0, 1), rows)
+    count = jax.tree_util.tree_leaves(rows)[0].shape[0]
     pad = lambda x: np.concatenate([x, np.repeat(x[-1:], -count % SCAN_CHUNK, axis=0)])
     rows = jax.tree_util.tree_map(lambda x: pad(np.asarray(x)), rows)
     carry, outs = host_state(carry), []
     for first in range(0, count + (-count % SCAN_CHUNK), SCAN_CHUNK):
         chunk = jax.tree_util.tree_map(lambda x: x[first: first + SCAN_CHUNK], rows)
-        carry, out = _scan(step, args, carry, chunk)
+        carry, out = _scan(step, args, carry, chunk, paths)
         outs.append(jax.device_get(out))
-    return jax.tree_util.tree_map(lambda *parts: np.concatenate(parts)[:count], *outs)
+    stacked = jax.tree_util.tree_map(lambda *parts: np.concatenate(parts)[:count], *outs)
+    return jax.tree_util.tree_map(lambda x: np.swapaxes(x, 0, 1), stacked) if paths else stacked

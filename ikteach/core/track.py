@@ -17,6 +17,7 @@ from .loop import RUNNING, iterate, start
 from .methods import require_traceable
 from .options import Options
 from .solve import as_options, prepare
+from .tasks import TASKS, task_for
 from .._runtime import engine
 
 NEVER = np.iinfo(np.int64).max  # max_iter for tracking: the loop's stops never fire
@@ -24,17 +25,23 @@ NEVER = np.iinfo(np.int64).max  # max_iter for tracking: the loop's stops never 
 
 @dataclasses.dataclass(frozen=True)
 class TrackResult:
-    """theta (T+1, n) from the start; error (T,) = sum_k |t_k - x_k| after each step."""
+    """theta (T+1, n) from the start; error (T,) = sum_k |t_k - x_k| after each step.
+    For P paths at once: theta (P, T+1, n) and error (P, T), one row per path."""
     theta: np.ndarray
     error: np.ndarray
 
     @property
     def mean_error(self):
-        return float(np.mean(self.error))
+        """The mean of error over the steps (one per path for several paths)."""
+        mean = np.mean(self.error, axis=-1)
+        return float(mean) if np.ndim(mean) == 0 else mean
 
     @property
     def jitter(self):
-        """ik.core.jitter.jitter of the joint path: the mean of sum_j |theta_j(t+1) - 2 theta_j(t) + theta_j(t-1)|."""
+        """ik.core.jitter.jitter of the joint path: the mean of sum_j |theta_j(t+1) - 2 theta_j(t) + theta_j(t-1)|
+        (one per path for several paths)."""
+        if self.theta.ndim == 3:
+            return np.array([jitter(path) for path in self.theta])
         return jitter(self.theta)
 
 
@@ -62,8 +69,10 @@ def track(arm, targets, theta0=None, method="dls", options=None, *, damping=None
           gamma_max=None, clamp_growth=False, **option_values):
     """Follow targets[0], targets[1], ... with one step of `method` each (Buss's protocol).
 
-    targets  (T, *target shape): one target (or one per end effector) per time step, T >= 1.
-    theta0   the start (default: all zeros).
+    targets  (T, *target shape): one target (or one per end effector) per time step, T >= 1;
+             or (P, T, *target shape): P paths followed side by side, each on its own (one
+             program steps them all at once: the same steps, vectorised).
+    theta0   the start (default: all zeros); for P paths one start for all or one per path (P, n).
     method, damping, rcond, gamma_max: as in ik.solve.
     options  as in ik.solve, of which tracking reads clamp (each end effector's error clamped to
              D_max), max_step, joint_limits, limit_mode, levels, rest_pose, rest_gain.
@@ -84,19 +93,49 @@ def track(arm, targets, theta0=None, method="dls", options=None, *, damping=None
     targets = as_array(targets, "targets")
     if targets.ndim < 2:
         raise ValueError(f"targets: expected one target per time step, got shape {targets.shape}")
-    if targets.shape[0] == 0:
+    if 0 in targets.shape[:2]:
         raise ValueError(f"targets: expected at least one time step, got none (shape "
                          f"{targets.shape})")
-    theta0 = np.zeros(arm.n_joints) if theta0 is None else as_array(theta0, "theta0",
-                                                                    shape=(arm.n_joints,))
+    paths = is_paths(arm, targets.shape)
+    shape = targets.shape
+    if paths:  # checked and prepared as one long path; stepped as P paths
+        targets = targets.reshape((-1,) + shape[2:])
+    n, count = arm.n_joints, shape[0] if paths else 1
+    theta0 = np.zeros(n) if theta0 is None else as_array(
+        theta0, "theta0", shape=(count, n) if paths and np.ndim(theta0) == 2 else (n,))
+    steps = shape[1] if paths else shape[0]
+    per_row = np.repeat(theta0, steps, axis=0) if theta0.ndim == 2 else theta0  # prepare's rows
     problem, method, options, theta0, targets = prepare(
-        arm, targets, theta0, method, options,
+        arm, targets, per_row, method, options,
         {"damping": damping, "rcond": rcond, "gamma_max": gamma_max}, rows="targets")
-    require_traceable(method, problem, theta0, "ik.track")
+    theta0 = np.broadcast_to(theta0.reshape(-1, n)[::steps], (count, n))
+    require_traceable(method, problem, theta0[0], "ik.track")
     options = replace(options, tol=0.0, stall_tol=0.0, max_iter=np.int64(NEVER))
-    effectors = jax.eval_shape(lambda q: effector_errors(problem, q), theta0).shape[0]
+    effectors = jax.eval_shape(lambda q: effector_errors(problem, q), theta0[0]).shape[0]
     d_max = np.full(effectors, options.clamp, dtype=float)
-    first_clamp = np.full(effectors, np.inf) if clamp_growth else d_max
+    first_clamp = np.broadcast_to(np.full(effectors, np.inf) if clamp_growth else d_max,
+                                  (count, effectors))
     args = (problem, method, options, d_max, np.asarray(bool(clamp_growth)))
-    thetas, errors = engine.run_scan(follow, args, (start(theta0), first_clamp), targets)
-    return TrackResult(np.concatenate([theta0[None], thetas]), np.asarray(errors))
+    starts = [(start(q), clamp) for q, clamp in zip(theta0, first_clamp)]  # one per path
+    if not paths:
+        thetas, errors = engine.run_scan(follow, args, starts[0], targets)
+        return TrackResult(np.concatenate([theta0, thetas]), np.asarray(errors))
+    stacked = jax.tree_util.tree_map(lambda *xs: np.stack([np.asarray(x) for x in xs]), *starts)
+    thetas, errors = engine.run_scan(follow, args, stacked, targets.reshape(shape), paths=True)
+    return TrackResult(np.concatenate([theta0[:, None], thetas], axis=1), np.asarray(errors))
+
+
+def is_paths(arm, shape):
+    """True when targets of this shape are P paths (P, T, *target), False for one path
+    (T, *target); a ValueError naming targets when neither."""
+    for paths, target_shape in ((False, shape[1:]), (True, shape[2:])):
+        try:
+            task_for(arm, target_shape, "targets")
+            return paths
+        except ValueError:
+            pass
+    wanted = " or ".join(t.target_shape(arm) for t in TASKS if t.accepts_arm(arm))
+    if not wanted:
+        task_for(arm, shape[1:], "targets")  # not an arm: its own message
+    raise ValueError(f"targets: expected shape (T, *target) for one path or (P, T, *target) for "
+                     f"P paths, target of shape {wanted}; got shape {tuple(shape)}")
