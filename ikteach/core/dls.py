@@ -53,6 +53,14 @@ def dls_step_normal(J, e, damping):
     return jnp.linalg.solve(J.T @ J + damping**2 * jnp.eye(n), J.T @ e)
 
 
+def damped_step(J, e, damping):
+    """The DLS step: dls_step_small for m <= 3 rows (points in the plane or in space: the
+    small inverse in closed form), else dls_step."""
+    if J.shape[0] <= 3:
+        return dls_step_small(J, e, damping)
+    return dls_step(J, e, damping)
+
+
 @method(data=("damping",))
 class DLS(JacobianMethod):
     """Damped least squares with damping lambda (a length: default L / 6)."""
@@ -63,9 +71,7 @@ class DLS(JacobianMethod):
             object.__setattr__(self, "damping", as_number(self.damping, "damping", minimum=0))
 
     def step(self, J, e):
-        if J.shape[0] <= 3:  # points in the plane or in space: the small inverse in closed form
-            return dls_step_small(J, e, self.damping)
-        return dls_step(J, e, self.damping)
+        return damped_step(J, e, self.damping)
 
     def resolved(self, length_scale):
         if self.damping is not None:

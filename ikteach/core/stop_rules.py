@@ -59,6 +59,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ._pytree import replace
+from .dls import damped_step
 from .priority import multilevel_step
 from .safeguards import cap_step
 from .._runtime import jit as runtime_jit
@@ -135,7 +136,10 @@ def probe(problem, theta, levels, free, lower, upper, sigma_max, slack):
     (module doc); returns where the probe ends and its level norms."""
     def light_step(q, damping):
         e, J = problem.error(q), problem.jacobian(q) * free
-        step = multilevel_step([(J[jnp.asarray(r)], e[jnp.asarray(r)]) for r in levels], damping)
+        if len(levels) == 1:  # one level: the DLS step (as multilevel_step, without its SVD)
+            step = damped_step(J[jnp.asarray(levels[0])], e[jnp.asarray(levels[0])], damping)
+        else:
+            step = multilevel_step([(J[jnp.asarray(r)], e[jnp.asarray(r)]) for r in levels], damping)
         return cap_step(step, PROBE_MAX_TURN)
 
     start = level_norms(problem.error(theta), levels)
