@@ -212,6 +212,18 @@ def in_flight(size, device=None):
     return min(SLOTS if platform == "cpu" else GPU_SLOTS, size)
 
 
+def rows_per_call(count, few=8, many=SLOTS):
+    """How many of `count` rows one call of a per-row program (the stall classifier) takes:
+    `few` for a handful of rows (a solve), `many` on a CPU, and on an accelerator all of them
+    at once (padded to bucket(count), up to GPU_SLOTS): a host round trip per 1,024 rows
+    would leave it idle. Few sizes, so few programs."""
+    if count <= few:
+        return few
+    if jax.local_devices()[0].platform == "cpu":
+        return many
+    return min(bucket(count), GPU_SLOTS)
+
+
 def run_queue(step, start, args, rows, starts):
     """Final states of every row (numpy). The rows are padded to bucket(count), so batches of
     nearby sizes share one program. Over several devices, device k takes rows k, k + D,

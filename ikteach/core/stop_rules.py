@@ -62,7 +62,7 @@ from ._pytree import replace
 from .dls import damped_step
 from .priority import multilevel_step
 from .safeguards import cap_step
-from .._runtime import jit as runtime_jit
+from .._runtime import engine, jit as runtime_jit
 
 STOP_RULES = ("joint_steps", "motion")
 STALL_FRACTION = 1e-5  # the report's loop: stall_tol = STALL_FRACTION x L (benchmarks/sweep.py)
@@ -191,7 +191,7 @@ def why_stopped(problem, theta, lower, upper, levels, tol, own_update):
     return jnp.where(own_update & (kind == CUT_SHORT), FIXED_POINT, kind)
 
 
-STALL_BLOCKS = (8, 1024)  # rows per call: a solve's, a batch's
+STALL_BLOCKS = (8, 1024)  # rows per call: a solve's, a batch's on a CPU (an accelerator: all)
 
 
 @partial(runtime_jit.jit, static_argnames=("levels",))
@@ -203,9 +203,10 @@ def _stall_kinds(problem, targets, thetas, lower, upper, levels, tol, own_update
 
 def why_stalled(problem, targets, thetas, looked, options, levels, own_update=False):
     """why_stopped of every row where `looked` (MINIMUM elsewhere). Rows go in blocks of
-    STALL_BLOCKS[0] (a few rows: a solve) or STALL_BLOCKS[1] (a batch), the last one padded:
-    two compiled programs per problem, whatever the count (a new count would otherwise compile
-    again: 0.3-0.5 s on a live map's lambda change).
+    STALL_BLOCKS[0] (a few rows: a solve) or STALL_BLOCKS[1] (a batch on a CPU; on an
+    accelerator all rows in one block, engine.rows_per_call), the last one padded: two
+    compiled programs per problem on a CPU, whatever the count (a new count would otherwise
+    compile again: 0.3-0.5 s on a live map's lambda change).
 
     Called once after the loop: targets (B, ...) and thetas (B, n) where each row stopped,
     looked (B,) True where the row ended "stalled" or "slow", options the solve's (tol,
@@ -216,7 +217,7 @@ def why_stalled(problem, targets, thetas, looked, options, levels, own_update=Fa
     if rows.size == 0:
         return kinds
     targets, thetas = np.asarray(targets), np.asarray(thetas)
-    block = STALL_BLOCKS[0] if rows.size <= STALL_BLOCKS[0] else STALL_BLOCKS[1]
+    block = engine.rows_per_call(rows.size, *STALL_BLOCKS)
     padded = np.concatenate([rows, np.repeat(rows[-1:], -rows.size % block)])
     n = np.shape(thetas)[-1]
     bounds = [np.broadcast_to(np.asarray(b, dtype=float), (n,)) for b in options.joint_limits]
