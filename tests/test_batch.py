@@ -143,8 +143,10 @@ def test_a_chaotic_run_may_drift_beyond_the_last_bits_but_not_in_status():
 
 
 def test_the_accelerator_path_gives_the_queues_statuses_and_iterations():
-    """On a GPU the whole batch is in flight (engine._run_all: a vmap of the loop, padding rows
+    """On a GPU the whole batch is in flight (engine._all: a vmap of the loop, padding rows
     idle); run here on the CPU it ends every row as the queue does."""
+    import jax
+
     from ikteach._runtime import engine
     from ikteach.core.loop import start
 
@@ -154,10 +156,11 @@ def test_the_accelerator_path_gives_the_queues_statuses_and_iterations():
     problem, method, options, theta0, targets = ik.core.solve.prepare(
         ARM, targets, START, "dls", ik.Options(max_iter=300), {}, rows="targets")
     size = engine.bucket(len(targets))
-    pad = lambda x: engine._padded(x, size)
-    starts = np.broadcast_to(theta0, (len(targets), 3))
-    state = engine._run_all(batch.iterate_row, start, engine.as_data((problem, method, options)),
-                            pad(targets), pad(starts), np.int64(len(targets)))
+    padded = np.minimum(np.arange(size), len(targets) - 1)  # copies of the last row
+    starts = np.broadcast_to(theta0, (size, 3))
+    mesh = engine._mesh(tuple(jax.local_devices()[:1]))
+    state = engine._run_queue(batch.iterate_row, start, engine.as_data((problem, method, options)),
+                              targets[padded], starts, np.array([len(targets)]), size, True, mesh)
     status = np.asarray(state.status)
     assert np.all(status[len(targets):] == -1)  # the padding never ran
     names = np.asarray(ik.STATUSES, dtype=object)[status[: len(targets)]]

@@ -11,7 +11,9 @@ is a NamedTuple with fields i, theta, error and status; it is running while stat
   run_queue    ik.solve_batch: jax.vmap of step over `slots` targets in flight; a slot whose
                target has finished takes the next one (the work is the sum of the iterations,
                not the batch size times the largest count); batches padded to a few sizes
-               (bucket) so a new batch size rarely compiles; split over CPU devices when several;
+               (bucket) so a new batch size rarely compiles; one path for one device or several
+               (a jax.sharding mesh: each device its share), the whole share in flight on an
+               accelerator;
   run_scan     ik.track: jax.lax.scan of one step per time step, SCAN_CHUNK steps per program
                (several paths side by side: jax.vmap of the step);
   until_stopped  the loop as one traceable while_loop, for a caller's own compiled program.
@@ -147,11 +149,7 @@ def _queue(step, start, args, rows, starts, count, slots):
     return jax.lax.while_loop(lambda c: jnp.any(c[1].status == RUNNING), body, carry)[2]
 
 
-_run_queue = partial(runtime_jit.jit, static_argnames=("step", "start", "slots"))(_queue)
-
-
-@partial(runtime_jit.jit, static_argnames=("step", "start"))
-def _run_all(step, start, args, rows, starts, count):
+def _all(step, start, args, rows, starts, count):
     """Every row in flight at once (an accelerator's whole batch): jax.vmap of the loop, the
     padding rows (index >= count) idle from the start."""
     def one(index, row, theta0):
@@ -178,13 +176,21 @@ def _mesh(devices):
     return jax.sharding.Mesh(np.array(devices), ("rows",))
 
 
-@partial(runtime_jit.jit, static_argnames=("step", "start", "slots", "mesh"))
-def _run_split(step, start, args, rows, starts, counts, slots, mesh):
-    """_queue on every device of the mesh, each on its share of the rows (counts: how many
-    of each device's rows are real)."""
-    shard_map, check_off = _shard_map()
+@partial(runtime_jit.jit, static_argnames=("step", "start", "slots", "whole", "mesh"))
+def _run_queue(step, start, args, rows, starts, counts, slots, whole, mesh):
+    """Each device of the mesh (one or several) solves its share of the rows (counts: how many
+    of each device's rows are real): _all when the whole share is in flight on an accelerator,
+    else _queue with `slots` in flight."""
+    def share(args, rows, starts, count):
+        count = jnp.reshape(count, ())  # traced: a new batch size in the same bucket compiles nothing
+        if whole:
+            return _all(step, start, args, rows, starts, count)
+        return _queue(step, start, args, rows, starts, count, slots)
     P = jax.sharding.PartitionSpec
-    share = lambda args, rows, starts, count: _queue(step, start, args, rows, starts, count, slots)
+    found = _shard_map()
+    if found is None:  # a jax without shard_map: one device
+        return share(args, rows, starts, counts)
+    shard_map, check_off = found
     return shard_map(share, mesh=mesh, in_specs=(P(), P("rows"), P("rows"), P("rows")),
                      out_specs=P("rows"), **check_off)(args, rows, starts, counts)
 
@@ -196,12 +202,6 @@ def split_devices(count):
     if len(devices) < 2 or count < SPLIT_FROM * len(devices) or _shard_map() is None:
         return None
     return tuple(devices)
-
-
-def _padded(x, size):
-    """x with its rows padded to `size` by copies of the last row (never solved)."""
-    x = np.asarray(x)
-    return np.concatenate([x, np.repeat(x[-1:], size - x.shape[0], axis=0)])
 
 
 def in_flight(size, device=None):
@@ -225,31 +225,24 @@ def rows_per_call(count, few=8, many=SLOTS):
 
 
 def run_queue(step, start, args, rows, starts):
-    """Final states of every row (numpy). The rows are padded to bucket(count), so batches of
-    nearby sizes share one program. Over several devices, device k takes rows k, k + D,
-    k + 2D, ... (neighbouring rows cost alike, so the shares take about as long)."""
+    """Final states of every row (numpy), through one path for one device or several (a
+    jax.sharding mesh, _run_queue). Device k of D takes rows k, k + D, k + 2D, ... (neighbouring
+    rows cost alike, so the shares take about as long); each share is padded to bucket(share),
+    so batches of nearby sizes share one program."""
     count, args = starts.shape[0], as_data(args)
-    devices = split_devices(count)
-    if devices is None:
-        size = bucket(count)
-        pad = lambda x: _padded(x, size)
-        rows, starts = jax.tree_util.tree_map(pad, rows), pad(starts)
-        slots = in_flight(size)
-        if slots == size and jax.local_devices()[0].platform != "cpu":
-            state = _run_all(step, start, args, rows, starts, np.int64(count))
-        else:
-            state = _run_queue(step, start, args, rows, starts, np.int64(count), slots)
-        return jax.tree_util.tree_map(lambda x: np.asarray(x)[:count], jax.device_get(state))
+    devices = split_devices(count) or tuple(jax.local_devices()[:1])
     d = len(devices)
     share = bucket(-(-count // d))
     order = np.minimum(np.arange(d)[:, None] + d * np.arange(share)[None, :], count - 1).ravel()
     counts = np.array([len(range(k, count, d)) for k in range(d)], dtype=np.int64)
     take = lambda x: np.asarray(x)[order]
-    state = _run_split(step, start, args, jax.tree_util.tree_map(take, rows), take(starts),
-                       counts, in_flight(share, devices[0]), _mesh(devices))
+    slots = in_flight(share, devices[0])
+    whole = slots == share and devices[0].platform != "cpu"
+    state = _run_queue(step, start, args, jax.tree_util.tree_map(take, rows), take(starts),
+                       counts, slots, whole, _mesh(devices))
     back = np.arange(count)
     back = (back % d) * share + back // d  # where row r went
-    return jax.tree_util.tree_map(lambda x: np.asarray(x)[back], state)
+    return jax.tree_util.tree_map(lambda x: np.asarray(x)[back], jax.device_get(state))
 
 
 @partial(runtime_jit.jit, static_argnames=("step", "paths"))
