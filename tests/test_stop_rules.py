@@ -1,6 +1,7 @@
 """The stop rules and what each status means: the default ("motion") rule decides alike at
 every scale, the report's sum |delta_theta| does not; "slow" is still closing in; a stop that is
-not at a minimum of ||e|| says why ("singular", "damped"); DLS stays finite at lambda = 0."""
+not at a minimum of ||e|| says why ("singular", "damped"); DLS at lambda = 0 on a singular J
+stops "diverged" at its start and never returns NaN."""
 import importlib
 
 import numpy as np

@@ -66,9 +66,11 @@ def _feedback_text(student, results):
             lines.append(f"  {line}")
         for note in r["notes"]:
             lines.append(f"  note: {note}")
-        for line in r.get("copied", []):
-            lines.append(f"  for the instructor: {line} (compiled code compared, names and "
-                         "docstrings ignored); the marks stand until the instructor decides")
+        copied = r.get("copied", [])
+        lines += [f"  for the instructor: {line}" for line in copied]
+        if copied:
+            lines.append("  (compiled code compared, names and docstrings ignored; the marks "
+                         "stand until the instructor decides)")
         if r.get("answer", "").strip():
             lines.append("  your written answer (not marked by the checker; read by the "
                          "instructor):")
