@@ -54,23 +54,29 @@ def block_size(task, rows):
     return getattr(task, "block_size", None) or rows
 
 
-@method(data=("damping", "rest_pose", "rest_gain"), meta=("levels", "block"))
+def level_rows(levels, block):
+    """The error's row indices of each priority level, level 0 first (levels: one priority
+    per block of `block` rows)."""
+    per_row = np.repeat(np.asarray(levels), block)
+    return tuple(np.flatnonzero(per_row == level) for level in sorted(set(levels)))
+
+
+@method(data=("rows", "damping", "rest_pose", "rest_gain"))
 class Priorities(JacobianMethod):
-    """The damped multilevel priority step (levels: one per error block of `block` rows)."""
-    levels: tuple
-    block: int
+    """The damped multilevel priority step. rows: the error's row indices of each level
+    (level_rows), data: the same sizes in another order reuse the compiled loop."""
+    rows: tuple
     damping: float
     rest_pose: object = None
     rest_gain: float = 0.0
 
-    def rows_by_level(self, rows):
-        per_row = np.repeat(np.asarray(self.levels), self.block)
-        return [np.flatnonzero(per_row == level) for level in sorted(set(self.levels))]
+    def rows_by_level(self, count):
+        return self.rows
 
     def delta(self, problem, theta, e, J, free=None):
         """J's rows split by level, the rest pose (if any) as the last level, J = I there
         less the joints a joint-limit pass pinned (free = False)."""
-        parts = [(J[rows], e[rows]) for rows in self.rows_by_level(J.shape[0])]
+        parts = [(J[rows], e[rows]) for rows in self.rows]
         if self.rest_pose is not None:
             free = jnp.ones(theta.shape[0], bool) if free is None else free
             parts.append((jnp.diag(free.astype(J.dtype)), self.rest_gain * (self.rest_pose - theta)))
@@ -104,4 +110,4 @@ def with_priorities(method, problem, theta0, options):
         rest_pose = jnp.asarray(rest_pose)
         gain = check_rest_gain(DEFAULT_REST_GAIN if options.rest_gain is None
                                else options.rest_gain, method.damping)
-    return Priorities(levels, block, method.damping, rest_pose, gain)
+    return Priorities(level_rows(levels, block), method.damping, rest_pose, gain)

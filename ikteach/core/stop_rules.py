@@ -52,8 +52,6 @@ A "slow" end (the stall rule fired while ||e|| still fell) stays "slow" only whe
 gains; otherwise ||e|| has stopped falling and it is named like a stall. KIND_STATUS names the
 status each kind reports. Joints resting on a joint limit and pushed against it count as fixed.
 """
-from functools import partial
-
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -194,7 +192,7 @@ def why_stopped(problem, theta, lower, upper, levels, tol, own_update):
 STALL_BLOCKS = (8, 1024)  # rows per call: a solve's, a batch's on a CPU (an accelerator: all)
 
 
-@partial(runtime_jit.jit, static_argnames=("levels",))
+@runtime_jit.jit
 def _stall_kinds(problem, targets, thetas, lower, upper, levels, tol, own_update):
     one = lambda t, q: why_stopped(replace(problem, target=t), q, lower, upper, levels, tol,
                                    own_update)
@@ -210,8 +208,9 @@ def why_stalled(problem, targets, thetas, looked, options, levels, own_update=Fa
 
     Called once after the loop: targets (B, ...) and thetas (B, n) where each row stopped,
     looked (B,) True where the row ended "stalled" or "slow", options the solve's (tol,
-    joint_limits), levels the error's rows per priority level; KIND_STATUS[kind] is the status
-    each row's kind reports."""
+    joint_limits), levels the error's rows per priority level (passed as data: levels of the
+    same sizes in another order share a program); KIND_STATUS[kind] is the status each row's
+    kind reports."""
     kinds = np.full(np.shape(looked), MINIMUM)
     rows = np.flatnonzero(looked)
     if rows.size == 0:
@@ -221,6 +220,7 @@ def why_stalled(problem, targets, thetas, looked, options, levels, own_update=Fa
     padded = np.concatenate([rows, np.repeat(rows[-1:], -rows.size % block)])
     n = np.shape(thetas)[-1]
     bounds = [np.broadcast_to(np.asarray(b, dtype=float), (n,)) for b in options.joint_limits]
+    levels = tuple(np.asarray(level, dtype=np.int64) for level in levels)  # data, not program
     found = [_stall_kinds(problem, targets[part], thetas[part], *bounds, levels, options.tol,
                           np.asarray(bool(own_update)))
              for part in padded.reshape(-1, block)]
