@@ -16,6 +16,8 @@ is a NamedTuple with fields i, theta, error and status; it is running while stat
                accelerator;
   run_scan     ik.track: jax.lax.scan of one step per time step, SCAN_CHUNK steps per program
                (several paths side by side: jax.vmap of the step);
+  run_rows     a per-row function (the stall classifier) over many rows: vmapped, in calls
+               of few sizes, split over the devices;
   until_stopped  the loop as one traceable while_loop, for a caller's own compiled program.
 """
 import functools
@@ -222,6 +224,34 @@ def rows_per_call(count, few=8, many=SLOTS):
     if jax.local_devices()[0].platform == "cpu":
         return many
     return min(bucket(count), GPU_SLOTS)
+
+
+@partial(runtime_jit.jit, static_argnames=("fn", "mesh"))
+def _per_row(fn, shared, rows, mesh):
+    """fn(shared, *row) for every row (jax.vmap), each device of the mesh its share."""
+    def share(shared, rows):
+        return jax.vmap(lambda *row: fn(shared, *row))(*rows)
+    found = _shard_map()
+    if found is None:  # a jax without shard_map: one device
+        return share(shared, rows)
+    shard_map, check_off = found
+    P = jax.sharding.PartitionSpec
+    return shard_map(share, mesh=mesh, in_specs=(P(), P("rows")), out_specs=P("rows"),
+                     **check_off)(shared, rows)
+
+
+def run_rows(fn, shared, rows, few=8, many=SLOTS):
+    """fn(shared, *row) for every row of `rows` (a tuple of arrays, one row each), as numpy:
+    rows_per_call(count, few, many) rows per device and call (the last call padded with
+    copies of the last row), over all devices when the rows are many (split_devices). A
+    per-row program then compiles for few sizes, whatever the count."""
+    count, shared = len(rows[0]), as_data(shared)
+    devices = split_devices(count) or tuple(jax.local_devices()[:1])
+    block = rows_per_call(-(-count // len(devices)), few, many) * len(devices)
+    padded = np.minimum(np.arange(count + (-count % block)), count - 1)
+    found = [_per_row(fn, shared, tuple(np.asarray(x)[part] for x in rows), _mesh(devices))
+             for part in padded.reshape(-1, block)]
+    return np.concatenate([np.asarray(f) for f in found])[:count]
 
 
 def run_queue(step, start, args, rows, starts):

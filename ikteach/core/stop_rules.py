@@ -60,7 +60,7 @@ from ._pytree import replace
 from .dls import damped_step
 from .priority import multilevel_step
 from .safeguards import cap_step
-from .._runtime import engine, jit as runtime_jit
+from .._runtime import engine
 
 STOP_RULES = ("joint_steps", "motion")
 STALL_FRACTION = 1e-5  # the report's loop: stall_tol = STALL_FRACTION x L (benchmarks/sweep.py)
@@ -192,19 +192,19 @@ def why_stopped(problem, theta, lower, upper, levels, tol, own_update):
 STALL_BLOCKS = (8, 1024)  # rows per call: a solve's, a batch's on a CPU (an accelerator: all)
 
 
-@runtime_jit.jit
-def _stall_kinds(problem, targets, thetas, lower, upper, levels, tol, own_update):
-    one = lambda t, q: why_stopped(replace(problem, target=t), q, lower, upper, levels, tol,
-                                   own_update)
-    return jax.vmap(one)(targets, thetas)
+def kind_of_row(shared, target, theta):
+    """why_stopped for one row of a batch: the problem with this row's target."""
+    problem, lower, upper, levels, tol, own_update = shared
+    return why_stopped(replace(problem, target=target), theta, lower, upper, levels, tol,
+                       own_update)
 
 
 def why_stalled(problem, targets, thetas, looked, options, levels, own_update=False):
-    """why_stopped of every row where `looked` (MINIMUM elsewhere). Rows go in blocks of
-    STALL_BLOCKS[0] (a few rows: a solve) or STALL_BLOCKS[1] (a batch on a CPU; on an
-    accelerator all rows in one block, engine.rows_per_call), the last one padded: two
-    compiled programs per problem on a CPU, whatever the count (a new count would otherwise
-    compile again: 0.3-0.5 s on a live map's lambda change).
+    """why_stopped of every row where `looked` (MINIMUM elsewhere), run by engine.run_rows:
+    STALL_BLOCKS[0] rows per call for a few rows (a solve), STALL_BLOCKS[1] per device for a
+    batch on a CPU (on an accelerator all rows at once), the last call padded: two compiled
+    programs per problem on a CPU, whatever the count (a new count would otherwise compile
+    again: 0.3-0.5 s on a live map's lambda change).
 
     Called once after the loop: targets (B, ...) and thetas (B, n) where each row stopped,
     looked (B,) True where the row ended "stalled" or "slow", options the solve's (tol,
@@ -215,14 +215,10 @@ def why_stalled(problem, targets, thetas, looked, options, levels, own_update=Fa
     rows = np.flatnonzero(looked)
     if rows.size == 0:
         return kinds
-    targets, thetas = np.asarray(targets), np.asarray(thetas)
-    block = engine.rows_per_call(rows.size, *STALL_BLOCKS)
-    padded = np.concatenate([rows, np.repeat(rows[-1:], -rows.size % block)])
     n = np.shape(thetas)[-1]
     bounds = [np.broadcast_to(np.asarray(b, dtype=float), (n,)) for b in options.joint_limits]
     levels = tuple(np.asarray(level, dtype=np.int64) for level in levels)  # data, not program
-    found = [_stall_kinds(problem, targets[part], thetas[part], *bounds, levels, options.tol,
-                          np.asarray(bool(own_update)))
-             for part in padded.reshape(-1, block)]
-    kinds[rows] = np.concatenate([np.asarray(f) for f in found])[: rows.size]
+    shared = (problem, *bounds, levels, options.tol, np.asarray(bool(own_update)))
+    kinds[rows] = engine.run_rows(kind_of_row, shared, (np.asarray(targets)[rows],
+                                                        np.asarray(thetas)[rows]), *STALL_BLOCKS)
     return kinds
