@@ -34,7 +34,7 @@ BUDGETS = {
     "04_damped_least_squares": 49,
     "05_singularities_out_of_reach": 136,
     "06_pose_targets_3d": 53,
-    "07_workspace_maps": 13,
+    "07_workspace_maps": 16,
     "08_methods_compared": 45,
     "09_characters": 27,
     "10_redundancy": 45,

@@ -103,3 +103,33 @@ def horse_path(n_points=400, centre=(1.0, 0.0), width=1.0):
     from skimage import data
 
     return fit_path(image_path(~data.horse(), n_points), centre, width)
+
+
+def reach_scene(arm, theta, reach_map, step, hide=None):
+    """A 3-D reachability map (ikteach/core/reach_map.py) drawn with pyvista around the arm at
+    theta (ik.pictures.scene): each grid point a sphere in its status colour (STATUS_COLORS),
+    reached points large, the others small; `hide` (G,) bool leaves points out (a cut-away)."""
+    from . import scene
+
+    pv = scene._pv()
+    p = scene.scene(arm, theta, window_size=(640, 480))
+    keep = np.ones(len(reach_map.points), bool) if hide is None else ~np.asarray(hide)
+    for name, colour in STATUS_COLORS.items():
+        chosen = keep & (reach_map.status == name)
+        if chosen.any():
+            size = 0.18 * step if name == "converged" else 0.07 * step
+            dots = pv.PolyData(reach_map.points[chosen]).glyph(
+                geom=pv.Sphere(radius=size, theta_resolution=10, phi_resolution=10),
+                scale=False, orient=False)
+            p.add_mesh(dots, color=colour, render=False)
+    shown = ", ".join(f"{int(np.sum(keep & (reach_map.status == s)))} {s} "
+                      f"({STATUS_COLOR_NAMES[s]})" for s in STATUS_COLORS
+                      if np.any(keep & (reach_map.status == s)))
+    eye, focus, up = p.camera_position  # scene's view, moved onto the grid's centre, wider
+    centre = reach_map.points[keep].mean(axis=0)
+    p.camera_position = [tuple(np.add(eye, centre - focus)), tuple(centre), up]
+    p.camera.zoom(0.8)
+    p._ikteach_alt = (f"{scene.describe(arm, theta)[:-1]}; around it {int(keep.sum())} of the "
+                      f"{len(keep)} grid points {step:g} apart as spheres by status: {shown}; "
+                      "reached points large, the others small.")
+    return p
