@@ -1,7 +1,8 @@
 """The book (make site) as a reader sees it, in headless Chromium from file:// (no server, no
 network): every page at a phone's width (375 px) and a laptop's (1280 px) with its math typeset
 (no raw TeX, no MathJax error), no console error, no serious or critical accessibility violation
-found by axe-core (npm, node_modules/axe-core) and nothing wider than the screen; the menu and
+found by axe-core (npm, node_modules/axe-core), no heading larger than one of higher rank and
+nothing wider than the screen; the menu and
 the page's contents open at 375, 768 and 1280 px; search finds pages with no console error from
 disk, and with snippets when served. Screenshots go to $BROWSER_SHOTS (default
 /tmp/ikteach-browser). The decks are tests/browser/site_slides.py.
@@ -80,6 +81,15 @@ def math_errors(driver):
         ".map(e => e.getAttribute('data-mjx-error') || e.textContent)")
 
 
+# A heading set larger than one of higher rank on its page (on a phone the theme's h2 and h3
+# outgrew the page's title, and the home page's lecture titles filled the screen).
+HEADINGS_OUT_OF_RANK = """
+const size = h => parseFloat(getComputedStyle(h).fontSize);
+const heads = [...document.querySelectorAll('.bd-article :is(h1, h2, h3, h4)')];
+return heads.filter(h => heads.some(g => g.tagName < h.tagName && size(g) < size(h)))
+            .map(h => `${h.tagName} ${size(h)}px ${h.innerText.slice(0, 40)}`);"""
+
+
 def overflow(driver):
     """How many CSS pixels the page is wider than the screen (0: it fits)."""
     return driver.execute_script(
@@ -112,6 +122,7 @@ def test_every_page_reads_right(site, driver, width):
                  "MathJax errors": math_errors(driver)[:2],
                  "console errors": console_errors(driver)[:2],
                  "axe": axe_violations(driver)[:2],
+                 "headings larger than a higher rank": driver.execute_script(HEADINGS_OUT_OF_RANK)[:2],
                  "wider than the screen by (px)": overflow(driver)}
         problems += [f"{page} at {width}: {what}: {value}" for what, value in found.items() if value]
         if page in SHOT_PAGES:
