@@ -284,9 +284,9 @@ def pdf(out=PDF, root=ROOT, chromium=CHROMIUM, quiet=True):
     headless Chromium once MathJax has typeset it (no LaTeX). Returns the PDF's path."""
     if not Path(chromium).is_file():
         raise SystemExit(f"pdf: no Chromium at {chromium}: `make pdf` installs Debian's chromium")
-    single = ROOT / "build" / "book-single"
-    single = sphinx(stage(root, beside(single, "src")), single, builder="singlehtml", quiet=quiet)
     out = Path(out)
+    single = out.parent / f"{out.stem}-single"  # build/book-single for build/book.pdf
+    single = sphinx(stage(root, beside(single, "src")), single, builder="singlehtml", quiet=quiet)
     out.parent.mkdir(parents=True, exist_ok=True)
     subprocess.run([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
                     "--disable-background-networking", "--no-pdf-header-footer",
