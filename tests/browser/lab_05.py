@@ -53,7 +53,7 @@ def notebook(lab, browser):
     """Notebook 05 open in JupyterLab, all cells run, and every change the cells made to the
     demo drawn: a cell's prompt is numbered on the kernel's reply, while the demo's picture is
     drawn from widget messages that may still be on their way (the last cell sets each preset in
-    turn), so that a picture found then was replaced under the test (a stale element)."""
+    turn): a picture found before they land is replaced under the test (a stale element)."""
     try:
         _run_all(lab, browser)
         last = _wait_until(lambda: _printed_last(browser), 60, "the presets cell's output")
@@ -108,12 +108,12 @@ def _settled(state):
     """The kernel has solved for where the x slider is, and the page shows that solve: the number
     box follows the slider, and the picture is named for that target and that status line (a
     drag sends many values; each solve redraws the picture, the last one wins)."""
-    if not state or state["slider"] is None or not state["status"]:
-        return False
-    target = re.search(r"at \((-?[\d.]+), (-?[\d.]+)\)", state["name"])
+    target = state and re.search(r"at \((-?[\d.]+), (-?[\d.]+)\)", state["name"])
+    if not target or not state["status"] or not state["slider"] or not state["readout"]:
+        return False  # not drawn yet
     x = float(state["slider"])
-    return (target is not None and abs(float(target[1]) - x) < 0.005
-            and abs(float(state["readout"]) - x) < 0.005 and state["status"] in state["name"])
+    return (abs(float(target[1]) - x) < 0.005 and abs(float(state["readout"]) - x) < 0.005
+            and state["status"] in state["name"])
 
 
 def _wait_settled(driver, what, extra=lambda state: True, timeout=60):
