@@ -166,7 +166,8 @@ BROWSER_PREREQS := $(STAMP) $(NODE_STAMP)
 define browser_setup
 	@test -x /usr/bin/chromium -a -x /usr/bin/chromedriver || \
 	  { $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq chromium chromium-driver; }
-	$(PY) -m pip install --quiet "selenium>=4.20"
+	@$(PY) -c "import selenium, sys; sys.exit(tuple(map(int, selenium.__version__.split('.')[:2])) < (4, 20))" \
+	  2>/dev/null || $(PY) -m pip install --quiet "selenium>=4.20"
 endef
 test-browser: $(BROWSER_PREREQS)
 	$(browser_setup)
