@@ -158,19 +158,23 @@ bench: $(STAMP)
 # A real browser (Debian's chromium + chromium-driver, driven by selenium) runs notebook 05 in
 # JupyterLab, drags the demo's slider and plays an animation, then runs every lecture notebook
 # (no error, nothing clipped, alt text on every image); then reads the book (every page at 375
-# and 1280 px, menus, search) and every deck at 1280 x 720. Not part of `make test`.
+# and 1280 px, menus, search), every deck at 1280 x 720, and make pdf's PDF (read back with
+# Debian's poppler-utils: every lecture in it, no raw TeX). Not part of `make test`.
 # `make test-browser-smoke` (CI: .ci/run): every book page at 375 px, the menus, one deck.
 SUDO := $(if $(filter 0,$(shell id -u)),,sudo)
 BROWSER_PREREQS := $(STAMP) $(NODE_STAMP)
 define browser_setup
 	@test -x /usr/bin/chromium -a -x /usr/bin/chromedriver || \
 	  { $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq chromium chromium-driver; }
-	$(PY) -m pip install --quiet "selenium>=4.20"
+	@$(PY) -c "import selenium, sys; sys.exit(tuple(map(int, selenium.__version__.split('.')[:2])) < (4, 20))" \
+	  2>/dev/null || $(PY) -m pip install --quiet "selenium>=4.20"
 endef
 test-browser: $(BROWSER_PREREQS)
 	$(browser_setup)
+	@test -x /usr/bin/pdftotext -a -x /usr/bin/pdfinfo || \
+	  { $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq poppler-utils; }
 	$(PY) -m pytest -v -p no:cacheprovider tests/browser/lab_05.py tests/browser/lab_notebooks.py \
-		tests/browser/site_book.py tests/browser/site_slides.py
+		tests/browser/site_book.py tests/browser/site_slides.py tests/browser/site_pdf.py
 
 test-browser-smoke: $(BROWSER_PREREQS)
 	$(browser_setup)

@@ -42,8 +42,9 @@ class Page(HTMLParser):
 
 
 @pytest.fixture(scope="module")
-def site(tmp_path_factory):
-    return book.build(tmp_path_factory.mktemp("book") / "site")
+def site():
+    """Built here every time, into build/test-site: the browser tests read the same book."""
+    return book.build(book.TESTED)
 
 
 @pytest.fixture(scope="module")
@@ -273,3 +274,25 @@ def test_the_site_group_is_the_site_extra():
     extra = project["project"]["optional-dependencies"]["site"]
     assert sorted(project["dependency-groups"]["site"]) == sorted(extra)
     assert not any(re.match(r"(jax|jupyterlab|ikteach)\b", dep) for dep in extra)
+
+
+def test_a_book_built_from_the_same_files_is_reused_and_a_change_builds_anew(tmp_path):
+    """The browser tests reuse build/test-site (book.build(reuse=True)) only while every file it
+    was built from is unchanged (book.inputs_digest)."""
+    root, out = tmp_path / "course", tmp_path / "out" / "site"
+    (root / "notebooks").mkdir(parents=True)
+    (root / "notebooks" / "01_a.ipynb").write_text("{}")
+    digest = book.inputs_digest(root)
+    assert book.inputs_digest(root) == digest
+    out.mkdir(parents=True)
+    (out / "index.html").write_text("built before")
+    book.beside(out, "cache").mkdir()
+    (book.beside(out, "cache") / "inputs.sha256").write_text(digest)
+    assert book.build(out, root, reuse=True) == out  # reused: nothing staged (no docs/conf.py)
+    for change in (lambda: (root / "notebooks" / "01_a.ipynb").write_text('{"cells": []}'),
+                   lambda: (root / "docs").mkdir() or (root / "docs" / "book.css").write_text("")):
+        change()
+        assert book.inputs_digest(root) != digest
+        with pytest.raises(SystemExit, match="no docs/conf.py"):  # builds anew: stages first
+            book.build(out, root, reuse=True)
+        digest = book.inputs_digest(root)

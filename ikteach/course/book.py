@@ -44,6 +44,7 @@ else:  # run as a file: `make site` from the light site venv (no JAX: see the Ma
 
 STAGE = ROOT / "build" / "site-src"  # beside(OUT, "src")
 OUT = ROOT / "build" / "site"
+TESTED = ROOT / "build" / "test-site"  # the book `make test` builds; the browser tests reuse it
 MATHJAX = ROOT / "node_modules" / "mathjax" / "es5"
 MATHJAX_FILES = ("tex-svg-full.js", "a11y", "ui", "sre", "adaptors")  # what the page may load
 ORIGINALS = "_notebooks"  # the committed notebooks as they are, for "download the notebook"
@@ -263,15 +264,47 @@ def sphinx(src, out, builder="html", quiet=True):
     return Path(out)
 
 
-def build(out=OUT, root=ROOT, quiet=True):
+# What a build reads besides the notebooks, the guides and docs/: the code that builds it, the
+# versions it runs with (uv.lock, package-lock.json) and the course's home (pyproject.toml).
+BUILT_FROM = ("README.md", "pyproject.toml", "uv.lock", "node_modules/.package-lock.json",
+              "ikteach/course/book.py", "ikteach/course/slides.py",
+              "ikteach/course/notebook_html.py", "ikteach/course/course_home.py")
+BUILT_FROM_FOLDERS = ("notebooks", "docs", "ikteach/course/slides_template")
+
+
+def inputs_digest(root=ROOT):
+    """A digest of everything a build of the book reads (names and bytes), and of the Python
+    that runs it: equal digests, the same book."""
+    import hashlib
+
+    root = Path(root)
+    files = [root / name for name in BUILT_FROM]
+    files += [p for folder in BUILT_FROM_FOLDERS for p in (root / folder).rglob("*")
+              if p.is_file() and "__pycache__" not in p.parts and ".ipynb_checkpoints" not in p.parts]
+    digest = hashlib.sha256(f"{sys.executable} {sys.version}".encode())
+    for path in sorted(set(files)):
+        digest.update(path.relative_to(root).as_posix().encode() + b"\0")
+        digest.update(path.read_bytes() if path.is_file() else b"(missing)")
+        digest.update(b"\0")
+    return digest.hexdigest()
+
+
+def build(out=OUT, root=ROOT, quiet=True, reuse=False):
     """Stage and run Sphinx (docs/conf.py), then the lectures' slides into out/slides;
-    returns the output folder."""
+    returns the output folder. reuse: keep a book already in out that was built from the same
+    inputs (inputs_digest, kept beside out: the browser tests reuse the one `make test` built)."""
     if __package__:
         from . import slides
     else:
         import slides
+    out, digest = Path(out), inputs_digest(root)
+    stamp = beside(out, "cache") / "inputs.sha256"
+    if reuse and (out / "index.html").is_file() and stamp.is_file() and stamp.read_text() == digest:
+        return out
+    stamp.unlink(missing_ok=True)  # a build that stops half way is never reused
     out = sphinx(stage(root, beside(out, "src")), out, quiet=quiet)
     slides.build(lectures(root), out / "slides")
+    stamp.write_text(digest)
     return out
 
 
@@ -284,9 +317,9 @@ def pdf(out=PDF, root=ROOT, chromium=CHROMIUM, quiet=True):
     headless Chromium once MathJax has typeset it (no LaTeX). Returns the PDF's path."""
     if not Path(chromium).is_file():
         raise SystemExit(f"pdf: no Chromium at {chromium}: `make pdf` installs Debian's chromium")
-    single = ROOT / "build" / "book-single"
-    single = sphinx(stage(root, beside(single, "src")), single, builder="singlehtml", quiet=quiet)
     out = Path(out)
+    single = out.parent / f"{out.stem}-single"  # build/book-single for build/book.pdf
+    single = sphinx(stage(root, beside(single, "src")), single, builder="singlehtml", quiet=quiet)
     out.parent.mkdir(parents=True, exist_ok=True)
     subprocess.run([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
                     "--disable-background-networking", "--no-pdf-header-footer",

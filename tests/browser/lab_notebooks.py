@@ -18,7 +18,7 @@ pytest.importorskip("selenium.webdriver")
 from selenium.webdriver.common.by import By  # noqa: E402
 
 from labdriver import (ROOT, chromium, code_cell_count, jupyterlab,  # noqa: E402
-                       run_all, shut_down_kernels)
+                       run_all, shut_down_kernels, wait_until)
 
 NOTEBOOKS = sorted(p.name for p in (ROOT / "notebooks").glob("[01][0-9]_*.ipynb"))
 RUN_ALL_TIMEOUT = 900  # s: the longest notebook on a busy 2-core machine
@@ -45,6 +45,13 @@ def browser():
     with chromium() as driver:
         yield driver
 
+
+# Widgets are drawn after their cell has run (the page asks the kernel for their state): every
+# widget output holds its view, or the error view that PROBLEMS reports.
+WIDGETS_DRAWN = """
+return [...document.querySelectorAll('.jp-NotebookPanel:not(.lm-mod-hidden) .jp-OutputArea-output'
+                                     + '[data-mime-type="application/vnd.jupyter.widget-view+json"]')]
+  .every(o => o.querySelector('.jupyter-widgets, .jupyter-widgets-error-widget'));"""
 
 # Checks run in the page over the open notebook's outputs.
 PROBLEMS = """
@@ -107,7 +114,7 @@ def test_notebook_runs_in_jupyterlab_unclipped_with_alt_text(lab, browser, shots
     except Exception:
         browser.save_screenshot(str(shots / f"{stem}-failed.png"))
         raise
-    time.sleep(1.0)  # widgets render after their cell ends
+    wait_until(lambda: browser.execute_script(WIDGETS_DRAWN), 60, f"{name}'s widgets to be drawn")
     found = browser.execute_script(PROBLEMS)
     _screenshots(browser, shots, stem)
     assert not found["errors"], found["errors"]

@@ -1,7 +1,8 @@
 """The book (make site) as a reader sees it, in headless Chromium from file:// (no server, no
 network): every page at a phone's width (375 px) and a laptop's (1280 px) with its math typeset
 (no raw TeX, no MathJax error), no console error, no serious or critical accessibility violation
-found by axe-core (npm, node_modules/axe-core) and nothing wider than the screen; the menu and
+found by axe-core (npm, node_modules/axe-core), no heading larger than one of higher rank and
+nothing wider than the screen; the menu and
 the page's contents open at 375, 768 and 1280 px; search finds pages with no console error from
 disk, and with snippets when served. Screenshots go to $BROWSER_SHOTS (default
 /tmp/ikteach-browser). The decks are tests/browser/site_slides.py.
@@ -47,7 +48,12 @@ def site_pages(site):
 
 
 @pytest.fixture(scope="module")
-def driver():
+def driver(book_browser):
+    return book_browser
+
+
+@pytest.fixture(scope="module")
+def second_browser():
     with chromium() as d:
         yield d
 
@@ -80,6 +86,15 @@ def math_errors(driver):
         ".map(e => e.getAttribute('data-mjx-error') || e.textContent)")
 
 
+# A heading set larger than one of higher rank on its page (on a phone the theme's h2 and h3
+# outgrew the page's title, and the home page's lecture titles filled the screen).
+HEADINGS_OUT_OF_RANK = """
+const size = h => parseFloat(getComputedStyle(h).fontSize);
+const heads = [...document.querySelectorAll('.bd-article :is(h1, h2, h3, h4)')];
+return heads.filter(h => heads.some(g => g.tagName < h.tagName && size(g) < size(h)))
+            .map(h => `${h.tagName} ${size(h)}px ${h.innerText.slice(0, 40)}`);"""
+
+
 def overflow(driver):
     """How many CSS pixels the page is wider than the screen (0: it fits)."""
     return driver.execute_script(
@@ -101,21 +116,36 @@ def shoot(driver, name):
     driver.save_screenshot(str(SHOTS / name))
 
 
-@pytest.mark.parametrize("width", [pytest.param("phone", marks=pytest.mark.smoke), "laptop"])
-def test_every_page_reads_right(site, driver, width):
-    """Math typeset, no console error, no serious axe violation, nothing wider than the screen."""
+def check_pages(driver, site, pages, width):
+    """Problems found on each of `pages` at `width`: math typeset, no console error, no serious
+    axe violation, headings in rank, nothing wider than the screen."""
     use_width(driver, width)
     problems = []
-    for page in site_pages(site):
+    for page in pages:
         open_page(driver, (site / page).as_uri())
         found = {"raw TeX": driver.execute_script(RAW_TEX)[:2],
                  "MathJax errors": math_errors(driver)[:2],
                  "console errors": console_errors(driver)[:2],
                  "axe": axe_violations(driver)[:2],
+                 "headings larger than a higher rank": driver.execute_script(HEADINGS_OUT_OF_RANK)[:2],
                  "wider than the screen by (px)": overflow(driver)}
         problems += [f"{page} at {width}: {what}: {value}" for what, value in found.items() if value]
         if page in SHOT_PAGES:
             shoot(driver, f"site-{SHOT_PAGES[page]}-{width}.png")
+    return problems
+
+
+@pytest.mark.parametrize("width", [pytest.param("phone", marks=pytest.mark.smoke), "laptop"])
+def test_every_page_reads_right(site, driver, second_browser, width):
+    """Every page checked (check_pages), half of them in a second Chromium at the same time (axe
+    takes most of the time, one core a page: a 2-core machine checks two pages at once)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    pages = site_pages(site)
+    with ThreadPoolExecutor(2) as pool:
+        halves = [pool.submit(check_pages, d, site, pages[i::2], width)
+                  for i, d in enumerate((driver, second_browser))]
+        problems = [problem for half in halves for problem in half.result()]
     assert problems == []
 
 
@@ -143,12 +173,10 @@ def test_the_menu_and_the_contents_open(site, driver, width):
     use_width(driver, width)
     open_page(driver, (site / "notebooks" / "04_damped_least_squares.html").as_uri())
     visible_button(driver, "primary-toggle").click()
-    time.sleep(0.5)
     if width == "laptop":  # the menu is a column: the button hides it, and shows it again
-        assert menu_state(driver) == (False, False, True)
+        wait_until(lambda: menu_state(driver) == (False, False, True), 5, "the menu column to hide")
         visible_button(driver, "primary-toggle").click()
-        time.sleep(0.5)
-        assert menu_state(driver) == (False, False, False)
+        wait_until(lambda: menu_state(driver) == (False, False, False), 5, "the menu column back")
         assert driver.execute_script(  # the contents column is there, nothing in it cut off
             "const toc = document.querySelector('#pst-secondary-sidebar');"
             "const box = toc.getBoundingClientRect();"
@@ -156,15 +184,14 @@ def test_the_menu_and_the_contents_open(site, driver, width):
             "  || e.getBoundingClientRect().right <= box.right + 1);"  # (MathML for screen readers)
             "return box.width > 100 && box.right <= window.innerWidth + 1 && inside")
         return
-    assert menu_state(driver)[0], "the site menu did not open"
+    wait_until(lambda: menu_state(driver)[0], 5, "the site menu to open")
     shoot(driver, f"site-menu-{width}.png")
     assert "Damped least squares" in driver.execute_script(
         "return document.querySelector('#pst-primary-sidebar-modal').innerText")
     driver.switch_to.active_element.send_keys(Keys.ESCAPE)
     wait_until(lambda: not any(menu_state(driver)), 5, "the menu to close")
     visible_button(driver, "secondary-toggle").click()
-    time.sleep(0.5)
-    assert menu_state(driver)[1], "the page's contents did not open"
+    wait_until(lambda: menu_state(driver)[1], 5, "the page's contents to open")
     assert driver.execute_script(
         "return document.querySelector('#pst-secondary-sidebar-modal a[href^=\"#\"]') !== null")
     shoot(driver, f"site-contents-{width}.png")

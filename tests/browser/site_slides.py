@@ -6,12 +6,11 @@ slides of lecture 04 go to $BROWSER_SHOTS (default /tmp/ikteach-browser).
 
 `-m smoke` (CI) checks lecture 04's deck."""
 import os
-import time
 from pathlib import Path
 
 import pytest
 
-from labdriver import chromium, wait_until
+from labdriver import wait_until
 
 ROOT = Path(__file__).resolve().parents[2]
 SHOTS = Path(os.environ.get("BROWSER_SHOTS", "/tmp/ikteach-browser"))
@@ -45,11 +44,11 @@ def decks(site):
 
 
 @pytest.fixture(scope="module")
-def driver():
-    with chromium() as d:
-        d.execute_cdp_cmd("Emulation.setDeviceMetricsOverride",
-                          {"width": 1280, "height": 720, "deviceScaleFactor": 1, "mobile": False})
-        yield d
+def driver(book_browser):
+    book_browser.execute_cdp_cmd("Emulation.setDeviceMetricsOverride",
+                                 {"width": 1280, "height": 720, "deviceScaleFactor": 1,
+                                  "mobile": False})
+    return book_browser
 
 
 def open_deck(driver, deck):
@@ -72,12 +71,13 @@ def check_deck(driver, deck, shots=()):
     indices = driver.execute_script("return Reveal.getSlides().map(s => Reveal.getIndices(s))")
     for where in indices:
         h, v = where["h"], where["v"] or 0
-        driver.execute_script(f"Reveal.slide({h}, {v});"
-                              "Reveal.getCurrentSlide().querySelectorAll('.fragment')"
-                              ".forEach(f => f.classList.add('visible'));"
-                              "Reveal.layout();")
-        time.sleep(0.2)
-        scale, hidden, bottom, right = driver.execute_script(MEASURE)
+        # reveal.js moves to the slide and lays it out (the deck's shrink-to-fit too) before
+        # Reveal.slide returns (no transition); the fragments only fade in: measured at once
+        scale, hidden, bottom, right = driver.execute_script(
+            f"Reveal.slide({h}, {v});"
+            "Reveal.getCurrentSlide().querySelectorAll('.fragment')"
+            ".forEach(f => f.classList.add('visible'));"
+            "Reveal.layout();" + MEASURE)
         if scale < MIN_SCALE:
             problems.append(f"slide {h}/{v}: shrunk to {scale:.0%}")
         if hidden:
