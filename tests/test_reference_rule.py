@@ -185,7 +185,7 @@ SPELLINGS = [
     # the paths the instant check follows too (test_instant_check_agrees)
     ("import_inside", 2, IMPORT_INSIDE, 0, "`jt_step` raised ReferenceBlocked", False),
     ("attribute_chain", 5, ATTRIBUTE_CHAIN, 0, "`stalled` raised ReferenceBlocked", False),
-    ("method_object", 4, METHOD_OBJECT, 0, "raised ReferenceBlocked: ikteach's dls_step_small",
+    ("method_object", 4, METHOD_OBJECT, 0, "raised ReferenceBlocked: ikteach's damped_step",
      False),
     ("lecture_parts", 7, LECTURE_PARTS, 0, "`priority_step` raised ReferenceBlocked", False),
     # the grader's own work on a student's file is bounded: graded as usual, nothing reported

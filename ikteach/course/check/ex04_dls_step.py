@@ -18,6 +18,7 @@ FUNCTIONS = ('dls_step', 'dls_step_normal')
 REFERENCES = ("ikteach.core.dls:dls_step",
               "ikteach.core.dls:dls_step_normal",
               "ikteach.core.dls:dls_step_small",  # what ik.DLS runs on 2-3 rows
+              "ikteach.core.dls:damped_step",  # ik.DLS's choice between the two
               "ikteach.core.priority:damped_pinv",
 )
 
