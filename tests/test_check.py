@@ -321,7 +321,7 @@ def jt_by_getattr(J, e):
 
 
 def dls_by_method_object(J, e, damping):
-    return np.asarray(ik.DLS(damping=damping).step(J, e))  # runs dls_step_small on <= 3 rows
+    return np.asarray(ik.DLS(damping=damping).step(J, e))  # runs damped_step, then dls_step_small
 
 
 def dls_by_method_table(J, e, damping):
@@ -343,9 +343,9 @@ def priority_from_lecture_parts(J1, e1, J2, e2, damping):
     (2, [jt_by_getattr], "ikteach.core.jt.jt_step"),
     (5, [lambda d, L, f: bool(ik.core.stop_rules.joint_steps(d) < f * np.sum(L)),
          stop_rule_step], "ikteach.core.stop_rules.joint_steps"),  # an attribute chain
-    (4, [dls_by_method_object, dls_by_method_table], "ikteach.core.dls.dls_step_small"),
+    (4, [dls_by_method_object, dls_by_method_table], "ikteach.core.dls.damped_step"),
     (4, [lambda J, e, d: np.asarray(MyDLS(damping=d).step(J, e)), ik.dls_step_normal],
-     "ikteach.core.dls.dls_step_small"),
+     "ikteach.core.dls.damped_step"),
     (3, [lambda J, e, rcond: np.asarray(ik.damped_pinv(J, 0.0)) @ e],  # J^+ at damping 0
      "ikteach.core.priority.damped_pinv"),
     (7, [priority_from_lecture_parts], "ikteach.core.priority.damped_pinv, "
