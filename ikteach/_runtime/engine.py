@@ -178,6 +178,18 @@ def _mesh(devices):
     return jax.sharding.Mesh(np.array(devices), ("rows",))
 
 
+def _on_mesh(share, mesh, shared, *split):
+    """share(shared, *split) on every device of the mesh, each on its rows of the `split`
+    arrays (`shared` goes to every device whole); outputs split by rows alike."""
+    found = _shard_map()
+    if found is None:  # a jax without shard_map: one device
+        return share(shared, *split)
+    shard_map, check_off = found
+    P = jax.sharding.PartitionSpec
+    return shard_map(share, mesh=mesh, in_specs=(P(),) + (P("rows"),) * len(split),
+                     out_specs=P("rows"), **check_off)(shared, *split)
+
+
 @partial(runtime_jit.jit, static_argnames=("step", "start", "slots", "whole", "mesh"))
 def _run_queue(step, start, args, rows, starts, counts, slots, whole, mesh):
     """Each device of the mesh (one or several) solves its share of the rows (counts: how many
@@ -188,13 +200,7 @@ def _run_queue(step, start, args, rows, starts, counts, slots, whole, mesh):
         if whole:
             return _all(step, start, args, rows, starts, count)
         return _queue(step, start, args, rows, starts, count, slots)
-    P = jax.sharding.PartitionSpec
-    found = _shard_map()
-    if found is None:  # a jax without shard_map: one device
-        return share(args, rows, starts, counts)
-    shard_map, check_off = found
-    return shard_map(share, mesh=mesh, in_specs=(P(), P("rows"), P("rows"), P("rows")),
-                     out_specs=P("rows"), **check_off)(args, rows, starts, counts)
+    return _on_mesh(share, mesh, args, rows, starts, counts)
 
 
 def split_devices(count):
@@ -231,13 +237,7 @@ def _per_row(fn, shared, rows, mesh):
     """fn(shared, *row) for every row (jax.vmap), each device of the mesh its share."""
     def share(shared, rows):
         return jax.vmap(lambda *row: fn(shared, *row))(*rows)
-    found = _shard_map()
-    if found is None:  # a jax without shard_map: one device
-        return share(shared, rows)
-    shard_map, check_off = found
-    P = jax.sharding.PartitionSpec
-    return shard_map(share, mesh=mesh, in_specs=(P(), P("rows")), out_specs=P("rows"),
-                     **check_off)(shared, rows)
+    return _on_mesh(share, mesh, shared, rows)
 
 
 def run_rows(fn, shared, rows, few=8, many=SLOTS):

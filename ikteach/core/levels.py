@@ -70,9 +70,6 @@ class Priorities(JacobianMethod):
     rest_pose: object = None
     rest_gain: float = 0.0
 
-    def rows_by_level(self, count):
-        return self.rows
-
     def delta(self, problem, theta, e, J, free=None):
         """J's rows split by level, the rest pose (if any) as the last level, J = I there
         less the joints a joint-limit pass pinned (free = False)."""

@@ -13,7 +13,7 @@ import numpy as np
 from ._pytree import replace
 from ._validate import as_array, round_finite
 from .joint_limits import with_limits
-from .levels import with_priorities
+from .levels import Priorities, with_priorities
 from .loop import CONVERGED, RUNNING, SLOW, STALLED, STATUSES, iterate, start
 from .methods import METHODS, as_method, check_method_target, traceable
 from .options import Options
@@ -118,8 +118,7 @@ def explain_stalls(problem, method, options, targets, thetas, status):
         return status
     rows = jax.eval_shape(problem.error, np.asarray(thetas)[0]).shape[0]
     inner = getattr(method, "inner", method)  # within joint limits: the method inside
-    by_level = inner.rows_by_level(rows) if hasattr(inner, "rows_by_level") else [range(rows)]
-    levels = tuple(tuple(int(i) for i in r) for r in by_level)
+    levels = inner.rows if isinstance(inner, Priorities) else (np.arange(rows),)
     own_update = not method.uses_jacobian and not np.isfinite(options.max_step)
     kinds = stop_rules.why_stalled(problem, targets, thetas, looked, options, levels, own_update)
     named = np.array([STATUSES.index(name) for name in stop_rules.KIND_STATUS])[kinds]
