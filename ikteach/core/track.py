@@ -103,12 +103,10 @@ def track(arm, targets, theta0=None, method="dls", options=None, *, damping=None
     n, count = arm.n_joints, shape[0] if paths else 1
     theta0 = np.zeros(n) if theta0 is None else as_array(
         theta0, "theta0", shape=(count, n) if paths and np.ndim(theta0) == 2 else (n,))
-    steps = shape[1] if paths else shape[0]
-    per_row = np.repeat(theta0, steps, axis=0) if theta0.ndim == 2 else theta0  # prepare's rows
-    problem, method, options, theta0, targets = prepare(
-        arm, targets, per_row, method, options,
+    problem, method, options, _, targets = prepare(
+        arm, targets, theta0.reshape(-1, n)[0], method, options,
         {"damping": damping, "rcond": rcond, "gamma_max": gamma_max}, rows="targets")
-    theta0 = np.broadcast_to(theta0.reshape(-1, n)[::steps], (count, n))
+    theta0 = np.broadcast_to(np.clip(theta0, *options.joint_limits), (count, n))  # as prepare does
     require_traceable(method, problem, theta0[0], "ik.track")
     options = replace(options, tol=0.0, stall_tol=0.0, max_iter=np.int64(NEVER))
     effectors = jax.eval_shape(lambda q: effector_errors(problem, q), theta0[0]).shape[0]
