@@ -172,15 +172,15 @@ def test_the_accelerator_path_gives_the_queues_statuses_and_iterations():
 
 
 def test_stalls_are_named_in_few_calls_of_few_sizes(monkeypatch):
-    """The stall classifier takes a solve's rows 8 at a time and a batch's 1,024 at a time on a
+    """The stall classifier takes a solve's rows one at a time and a batch's 1,024 at a time on a
     CPU; on an accelerator all of a batch's rows in one call (padded to a power of two)."""
     from types import SimpleNamespace
 
     from ikteach._runtime import engine
 
-    assert [engine.rows_per_call(k) for k in (1, 8, 9, 5000)] == [8, 8, engine.SLOTS, engine.SLOTS]
+    assert [engine.rows_per_call(k) for k in (1, 8, 9, 5000)] == [1, 1, engine.SLOTS, engine.SLOTS]
     gpu = [SimpleNamespace(platform="gpu")]
     monkeypatch.setattr(engine.jax, "local_devices", lambda: gpu)
-    assert [engine.rows_per_call(k) for k in (3, 9, 1000, 5000)] == [8, 16, 1024, 8192]
+    assert [engine.rows_per_call(k) for k in (3, 9, 1000, 5000)] == [1, 16, 1024, 8192]
     monkeypatch.setattr(engine, "GPU_SLOTS", 4096)
     assert engine.rows_per_call(5000) == 4096

@@ -222,34 +222,41 @@ def in_flight(size, device=None):
 
 def rows_per_call(count, few=8, many=SLOTS):
     """How many of `count` rows one call of a per-row program (the stall classifier) takes:
-    `few` for a handful of rows (a solve), `many` on a CPU, and on an accelerator all of them
-    at once (padded to bucket(count), up to GPU_SLOTS): a host round trip per 1,024 rows
-    would leave it idle. Few sizes, so few programs."""
+    one for a handful of rows (up to `few`: a solve's one row, a small batch's few, one call
+    each), `many` on a CPU, and on an accelerator all of them at once (padded to
+    bucket(count), up to GPU_SLOTS): a host round trip per 1,024 rows would leave it idle.
+    Few sizes, so few programs."""
     if count <= few:
-        return few
+        return 1
     if jax.local_devices()[0].platform == "cpu":
         return many
     return min(bucket(count), GPU_SLOTS)
 
 
-@partial(runtime_jit.jit, static_argnames=("fn", "mesh"))
-def _per_row(fn, shared, rows, mesh):
+def _rows(fn, shared, rows, mesh):
     """fn(shared, *row) for every row (jax.vmap), each device of the mesh its share."""
     def share(shared, rows):
         return jax.vmap(lambda *row: fn(shared, *row))(*rows)
     return _on_mesh(share, mesh, shared, rows)
 
 
+_per_row = runtime_jit.jit(_rows, static_argnames=("fn", "mesh"))
+_one_row = runtime_jit.jit(_rows, static_argnames=("fn", "mesh"), light=True)  # runs briefly
+
+
 def run_rows(fn, shared, rows, few=8, many=SLOTS):
     """fn(shared, *row) for every row of `rows` (a tuple of arrays, one row each), as numpy:
     rows_per_call(count, few, many) rows per device and call (the last call padded with
     copies of the last row), over all devices when the rows are many (split_devices). A
-    per-row program then compiles for few sizes, whatever the count."""
+    per-row program then compiles for few sizes, whatever the count; the one-row program
+    compiles light (ikteach/_runtime/jit.py: it runs briefly)."""
     count, shared = len(rows[0]), as_data(shared)
     devices = split_devices(count) or tuple(jax.local_devices()[:1])
-    block = rows_per_call(-(-count // len(devices)), few, many) * len(devices)
+    per_call = rows_per_call(-(-count // len(devices)), few, many)
+    block = per_call * len(devices)
+    program = _one_row if per_call == 1 else _per_row
     padded = np.minimum(np.arange(count + (-count % block)), count - 1)
-    found = [_per_row(fn, shared, tuple(np.asarray(x)[part] for x in rows), _mesh(devices))
+    found = [program(fn, shared, tuple(np.asarray(x)[part] for x in rows), _mesh(devices))
              for part in padded.reshape(-1, block)]
     return np.concatenate([np.asarray(f) for f in found])[:count]
 

@@ -1,4 +1,4 @@
-"""jax.jit for the course's whole-loop programs, on JAX's public API, with two choices that
+"""jax.jit for the course's whole-loop programs, on JAX's public API, with three choices that
 buy speed and can each be turned off without changing a result.
 
 1. XLA's classic CPU emitters (`compiler_options`, a public argument of jax.jit). The newer
@@ -9,7 +9,14 @@ buy speed and can each be turned off without changing a result.
    program: a jaxlib that does not know the option gets plain jax.jit.
    IKTEACH_XLA_OPTIONS=off turns it off (tests/test_jit.py: same statuses, iterations, angles).
 
-2. A bound on what one process keeps compiled. Each whole-loop program holds about 140 memory
+2. Light programs: a program that runs once on a row or two (the stall classifier after a
+   solve) is compiled at XLA's lowest backend optimisation level (`xla_backend_optimization_level`
+   0, also a compiler option). It compiles in about half the time and runs about three times
+   slower, milliseconds for one row; the classifier's 1,024-row program for a batch is
+   compiled in full. Tried alike (a jaxlib that does not take it compiles in full), and off
+   with IKTEACH_XLA_OPTIONS=off.
+
+3. A bound on what one process keeps compiled. Each whole-loop program holds about 140 memory
    mappings and 5 MB; a kernel used all lecture long would otherwise reach the system's limit
    on mappings (vm.max_map_count, 65530 on Debian) and die. When MAX_PROGRAMS programs have
    been compiled since the last clear (counted by JAX's public compile events, which cost
@@ -28,6 +35,7 @@ import jax
 OPTIONS_ENV = "IKTEACH_XLA_OPTIONS"
 BOUND_ENV = "IKTEACH_MAX_PROGRAMS"
 FAST_COMPILE = {"xla_cpu_use_fusion_emitters": False}
+LIGHT_COMPILE = {"xla_backend_optimization_level": 0}
 MAX_PROGRAMS = 256
 
 
@@ -41,11 +49,16 @@ def supported(options):
 
 
 @functools.lru_cache(maxsize=None)
-def compiler_options():
-    """FAST_COMPILE if this jaxlib takes it and IKTEACH_XLA_OPTIONS is not "off", else None."""
+def compiler_options(light=False):
+    """FAST_COMPILE (and LIGHT_COMPILE when light), each where this jaxlib takes it; None when
+    it takes neither or IKTEACH_XLA_OPTIONS is "off"."""
     if os.environ.get(OPTIONS_ENV, "").strip().lower() in ("off", "0", "false", "no"):
         return None
-    return dict(FAST_COMPILE) if supported(FAST_COMPILE) else None
+    options = {}
+    for wanted in (FAST_COMPILE, LIGHT_COMPILE) if light else (FAST_COMPILE,):
+        if supported(wanted):
+            options.update(wanted)
+    return options or None
 
 
 def max_programs():
@@ -84,14 +97,15 @@ def keep_within_bound():
 class Program:
     """A jitted whole-loop program, run within the bound on compiled programs."""
 
-    def __init__(self, fun, static_argnames=(), fast_compile=True):
+    def __init__(self, fun, static_argnames=(), fast_compile=True, light=False):
         self.fun, self.static_argnames, self.fast_compile = fun, tuple(static_argnames), fast_compile
+        self.light = light
         self._jitted = None
         functools.update_wrapper(self, fun)
 
     def jitted(self):
         if self._jitted is None:
-            options = compiler_options() if self.fast_compile else None
+            options = compiler_options(self.light) if self.fast_compile else None
             kwargs = {"compiler_options": options} if options else {}
             self._jitted = jax.jit(self.fun, static_argnames=self.static_argnames, **kwargs)
         return self._jitted
@@ -106,11 +120,13 @@ class Program:
         return self.jitted()(*args, **kwargs)
 
 
-def jit(fun=None, fast_compile=True, static_argnames=()):
-    """Program(fun): jax.jit with compiler_options() and the bound above; as a decorator with
-    or without arguments (`@jit`, `@partial(jit, static_argnames=...)`). Static arguments are
-    named in static_argnames. fast_compile=False compiles exactly as jax.jit does."""
+def jit(fun=None, fast_compile=True, static_argnames=(), light=False):
+    """Program(fun): jax.jit with compiler_options(light) and the bound above; as a decorator
+    with or without arguments (`@jit`, `@partial(jit, static_argnames=...)`). Static arguments
+    are named in static_argnames. fast_compile=False compiles exactly as jax.jit does; light:
+    a program that runs briefly (module doc, 2)."""
     if fun is None:
-        return functools.partial(jit, fast_compile=fast_compile, static_argnames=static_argnames)
-    return Program(fun, static_argnames, fast_compile)
+        return functools.partial(jit, fast_compile=fast_compile, static_argnames=static_argnames,
+                                 light=light)
+    return Program(fun, static_argnames, fast_compile, light)
 

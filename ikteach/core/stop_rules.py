@@ -158,11 +158,10 @@ def saddle(problem, theta, rows, free, sigma_max):
     """The Hessian of 1/2 ||e_0||^2 (level 0's rows, the free joints) clearly negative somewhere.
     Only level 0: a later level moves on the curved set where the levels before it stay met,
     whose curvature its own Hessian does not see (a saddle there reads as a minimum).
-    H is the derivative of the gradient J_e^T e_0 (J_e = de_0/dtheta), both forward mode: the
-    same H as jax.hessian, a smaller program to compile."""
-    e0 = lambda q: problem.error(q)[jnp.asarray(rows)]
-    gradient = lambda q: jax.jacfwd(e0)(q).T @ e0(q)  # of 1/2 ||e_0||^2 (e_0 as given: exact)
-    H = jnp.where(free[:, None] & free[None, :], jax.jacfwd(gradient)(theta), 0.0)
+    H = jax.hessian, forward over reverse mode: n forward passes of the gradient, each one
+    reverse pass (a 57-joint character: 12 ms a row, where forward over forward took 260 ms)."""
+    half_square = lambda q: 0.5 * jnp.sum(problem.error(q)[jnp.asarray(rows)] ** 2)
+    H = jnp.where(free[:, None] & free[None, :], jax.hessian(half_square)(theta), 0.0)
     return jnp.linalg.eigvalsh(H)[0] < -CURVATURE_FRACTION * sigma_max**2
 
 
@@ -189,7 +188,7 @@ def why_stopped(problem, theta, lower, upper, levels, tol, own_update):
     return jnp.where(own_update & (kind == CUT_SHORT), FIXED_POINT, kind)
 
 
-STALL_BLOCKS = (8, 1024)  # rows per call: a solve's, a batch's on a CPU (an accelerator: all)
+STALL_BLOCKS = (8, 1024)  # up to 8 rows: one per call (a solve's); 1,024 per call for a batch
 
 
 def kind_of_row(shared, target, theta):
@@ -201,10 +200,11 @@ def kind_of_row(shared, target, theta):
 
 def why_stalled(problem, targets, thetas, looked, options, levels, own_update=False):
     """why_stopped of every row where `looked` (MINIMUM elsewhere), run by engine.run_rows:
-    STALL_BLOCKS[0] rows per call for a few rows (a solve), STALL_BLOCKS[1] per device for a
-    batch on a CPU (on an accelerator all rows at once), the last call padded: two compiled
-    programs per problem on a CPU, whatever the count (a new count would otherwise compile
-    again: 0.3-0.5 s on a live map's lambda change).
+    one row per call for up to STALL_BLOCKS[0] rows (a solve's, a small batch's; compiled light:
+    ikteach/_runtime/jit.py), STALL_BLOCKS[1] per device for a batch on a CPU (on an
+    accelerator all rows at once), the last call padded: two compiled programs per problem on a
+    CPU, whatever the count (a new count would otherwise compile again: 0.3-0.5 s on a live
+    map's lambda change).
 
     Called once after the loop: targets (B, ...) and thetas (B, n) where each row stopped,
     looked (B,) True where the row ended "stalled" or "slow", options the solve's (tol,
