@@ -17,12 +17,13 @@ ik.notebook.compilation_cache()  # as in the tests' own process: a second run co
 arm = ik.planar_chain([1.0, 0.7, 0.4])
 g = np.linspace(-2.3, 2.3, 24)
 targets = np.stack(np.meshgrid(g, g), -1).reshape(-1, 2)
-out = {"options": xla.compiler_options()}
+out = {"options": xla.compiler_options(), "light": xla.compiler_options(light=True)}
 for method in ("dls", "jt", "sdls", "ccd"):
     b = ik.solve_batch(arm, targets, [0.3, 0.2, 0.1], method=method, max_iter=150)
     r = ik.solve(arm, [1.2, 0.9], [0.3, 0.2, 0.1], method=method, clamp=0.5)
+    far = ik.solve(arm, [2.5, 0.6], [0.3, 0.2, 0.1], method=method)  # out of reach: named light
     out[method] = [b.status.tolist(), b.iterations.tolist(), b.theta.tolist(),
-                   r.status, r.iterations, r.theta.tolist()]
+                   r.status, r.iterations, r.theta.tolist(), far.status]
 print(json.dumps(out))
 """
 
@@ -51,17 +52,20 @@ def test_the_locked_jaxlib_takes_the_fast_compile_option():
     if _jaxlib_version() < (0, 12):
         assert xla.supported(xla.FAST_COMPILE)
         assert xla.compiler_options() == xla.FAST_COMPILE
+        assert xla.compiler_options(light=True) == {**xla.FAST_COMPILE, **xla.LIGHT_COMPILE}
     else:
         assert not xla.supported(xla.FAST_COMPILE) and xla.compiler_options() is None
+    assert xla.supported(xla.LIGHT_COMPILE)  # a long-standing option of XLA's
 
 
 def test_with_and_without_the_options_every_solve_ends_the_same():
     fast, plain = run("on"), run("off")
     on = xla.FAST_COMPILE if xla.supported(xla.FAST_COMPILE) else None  # see the test above
-    assert fast["options"] == on and plain["options"] is None
+    assert fast["options"] == on and plain["options"] is None and plain["light"] is None
+    assert xla.LIGHT_COMPILE.items() <= fast["light"].items()
     for method in ("dls", "jt", "sdls", "ccd"):
-        (bs, bi, bt, rs, ri, rt), (ps, pi, pt, qs, qi, qt) = fast[method], plain[method]
-        assert bs == ps and bi == pi and (rs, ri) == (qs, qi), method
+        (bs, bi, bt, rs, ri, rt, rf), (ps, pi, pt, qs, qi, qt, qf) = fast[method], plain[method]
+        assert bs == ps and bi == pi and (rs, ri, rf) == (qs, qi, qf), method
         np.testing.assert_allclose(bt, pt, atol=1e-9, err_msg=method)
         np.testing.assert_allclose(rt, qt, atol=1e-9, err_msg=method)
 

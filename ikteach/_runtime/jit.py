@@ -49,15 +49,21 @@ def supported(options):
 
 
 @functools.lru_cache(maxsize=None)
+def _taken():
+    """Which of FAST_COMPILE and LIGHT_COMPILE this jaxlib takes: both tried in one program,
+    each alone only when that fails."""
+    if supported({**FAST_COMPILE, **LIGHT_COMPILE}):
+        return True, True
+    return supported(FAST_COMPILE), supported(LIGHT_COMPILE)
+
+
 def compiler_options(light=False):
     """FAST_COMPILE (and LIGHT_COMPILE when light), each where this jaxlib takes it; None when
-    it takes neither or IKTEACH_XLA_OPTIONS is "off"."""
+    none is taken or IKTEACH_XLA_OPTIONS is "off"."""
     if os.environ.get(OPTIONS_ENV, "").strip().lower() in ("off", "0", "false", "no"):
         return None
-    options = {}
-    for wanted in (FAST_COMPILE, LIGHT_COMPILE) if light else (FAST_COMPILE,):
-        if supported(wanted):
-            options.update(wanted)
+    fast, lite = _taken()
+    options = {**(FAST_COMPILE if fast else {}), **(LIGHT_COMPILE if light and lite else {})}
     return options or None
 
 
