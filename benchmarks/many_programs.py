@@ -8,11 +8,16 @@ Debian) after about 430 programs.
 
     .venv/bin/python benchmarks/many_programs.py [--solves 10000] [--bound N]
 
---bound sets IKTEACH_MAX_PROGRAMS for the run (0: no bound) to compare.
+--bound sets IKTEACH_MAX_PROGRAMS for the run (0: no bound) to compare. JAX's persistent
+compilation cache is on, in an empty folder, as ik.notebook.setup() turns it on in a notebook:
+after the bound clears JAX's caches, the programs still in use load from it (--no-cache: they
+compile again).
 """
 import argparse
 import os
 import resource
+import shutil
+import tempfile
 import time
 
 import numpy as np
@@ -35,12 +40,19 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--solves", type=int, default=10_000)
     ap.add_argument("--bound", type=int, default=None)
+    ap.add_argument("--no-cache", action="store_true",
+                    help="without JAX's persistent compilation cache (a notebook has it on: "
+                         "ik.notebook.setup()); a clear then compiles again what it loads")
     args = ap.parse_args()
     if args.bound is not None:
         os.environ["IKTEACH_MAX_PROGRAMS"] = str(args.bound)
     import ikteach as ik
     from jax import monitoring
     from ikteach._runtime import jit as runtime_jit
+
+    cache = None if args.no_cache else tempfile.mkdtemp(prefix="ikteach-cache-")
+    if cache:  # as ik.notebook.setup() does, with an empty cache: a first run
+        ik.notebook.compilation_cache(cache)
 
     compiles = []
     monitoring.register_event_duration_secs_listener(
@@ -52,6 +64,7 @@ def main():
                                   [[0.0, 0.0, 0.3]] * n) for n in range(1, 13)}
     ur5 = ik.core.robots.ur5()
     print(f"bound: {runtime_jit.max_programs() or 'none'} programs; "
+          f"persistent cache: {'on (empty at the start)' if cache else 'off'}; "
           f"vm.max_map_count {open('/proc/sys/vm/max_map_count').read().strip()}")
     print(f"| {'solves':>7} | {'seconds':>8} | {'compiles':>8} | {'clears':>6} | "
           f"{'mappings':>8} | {'RSS MB':>7} |")
@@ -96,6 +109,8 @@ def main():
                   f"{runtime_jit.clears[0]:>6} | {mappings():>8,} | {rss_mb():>7.0f} |", flush=True)
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     print(f"statuses: {statuses}; peak RSS {peak:.0f} MB")
+    if cache:
+        shutil.rmtree(cache, ignore_errors=True)
 
 
 if __name__ == "__main__":

@@ -53,3 +53,11 @@ def test_ikteach_warm_says_when_the_cache_is_off(monkeypatch, capsys):
     monkeypatch.setenv("IKTEACH_JAX_CACHE", "off")
     assert warm.main([]) == 2
     assert "cache is off" in capsys.readouterr().err
+
+
+def test_no_lecture_within_its_budget_reaches_the_program_bound():
+    """The bound on compiled programs (ikteach/_runtime/jit.py) clears JAX's caches only past
+    every lecture's budget: a lecture's Run All never clears them."""
+    from ikteach._runtime import jit as runtime_jit
+
+    assert max(BUDGETS.values()) <= runtime_jit.MAX_PROGRAMS

@@ -17,15 +17,18 @@ buy speed and can each be turned off without changing a result.
    with IKTEACH_XLA_OPTIONS=off.
 
 3. A bound on what one process keeps compiled. Each whole-loop program holds about 140 memory
-   mappings and 5 MB; a kernel used all lecture long would otherwise reach the system's limit
+   mappings and 5-8 MB; a kernel used all lecture long would otherwise reach the system's limit
    on mappings (vm.max_map_count, 65530 on Debian) and die. When MAX_PROGRAMS programs have
-   been compiled since the last clear (counted by JAX's public compile events, which cost
-   nothing per call), JAX's caches are cleared with its public
-   jax.clear_caches(): the programs still in use compile again, or load from JAX's persistent
-   compilation cache when ik.notebook.setup() turned it on (benchmarks/many_programs.py shows
-   mappings and memory levelling off). MAX_PROGRAMS = 256 is about 27,000 mappings, well under
-   the limit, and above the 6 methods x 12 joint counts x 2 dimensions a whole course uses (a
-   lower bound would clear and recompile over and over). IKTEACH_MAX_PROGRAMS=0 turns it off.
+   been compiled or loaded since the last clear (counted by JAX's public compile events, which
+   cost nothing per call; a load from the persistent cache counts too), JAX's caches are
+   cleared with its public jax.clear_caches(): the programs still in use compile again, or
+   load from JAX's persistent compilation cache when ik.notebook.setup() turned it on
+   (benchmarks/many_programs.py shows mappings and memory levelling off). MAX_PROGRAMS = 256
+   is about 27,000 mappings, well under the limit, and above every lecture's budget
+   (ikteach/course/warm.py: BUDGETS; tests/test_compile_budget.py). A lower bound does not buy
+   memory where the cache is on: 10,000 varied solves held 1,554 MB with 256 and 1,575 MB with
+   144 (the reloaded programs take the freed room and more), and took 40 % longer.
+   IKTEACH_MAX_PROGRAMS=0 turns it off.
 """
 import functools
 import os
