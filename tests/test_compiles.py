@@ -192,10 +192,14 @@ def test_a_rest_gain_or_pose_weights_after_solves_without_them_compile_nothing()
 
 def test_batch_sizes_in_one_bucket_share_a_program():
     """solve_batch pads a batch to the next power of two (engine.bucket) and traces the count:
-    9 to 16 targets run one program, 17 to 32 the next; the padding is never solved."""
-    from ikteach._runtime.engine import bucket
+    9 to 16 targets run one program, 17 to 32 the next; the padding is never solved. A CPU's
+    queue (1,024 in flight) pads past 1,024 rows to 8,192, 65,536, ...: the padding is never
+    loaded into a slot, so a 128 x 128 map and a 256 x 256 one share a program."""
+    from ikteach._runtime.engine import SLOTS, bucket
 
     assert [bucket(n) for n in (9, 16, 17, 100, 1000, 1025)] == [16, 16, 32, 128, 1024, 2048]
+    queued = [bucket(n, queued=True) for n in (9, 1000, 1024, 1025, 8192, 16384, 65536, 65537)]
+    assert queued == [16, 1024, 1024, 8192, 8192, 65536, 65536, 524288] and SLOTS == 1024
     arm, start = ik.planar_chain([0.7] * 4), np.full(4, 0.2)  # a shape no other test uses
     targets = np.random.default_rng(4).uniform(-2.0, 2.0, size=(32, 2))
     first = _programs_during(lambda: ik.solve_batch(arm, targets[:9], start, stall_tol=0))
@@ -207,3 +211,21 @@ def test_batch_sizes_in_one_bucket_share_a_program():
     part = ik.solve_batch(arm, targets[:10], start, stall_tol=0)
     np.testing.assert_array_equal(part.theta, whole.theta[:10])
     np.testing.assert_array_equal(part.iterations, whole.iterations[:10])
+
+
+def test_a_large_batch_of_another_size_reuses_the_queue():
+    """Past the queue's 1,024 slots batches of 2,000 and 5,000 targets share one program (the
+    8,192 bucket), and the results are the rows' own: as when each is solved alone."""
+    arm, start = ik.planar_chain([0.8] * 4), np.full(4, 0.3)  # a shape no other test uses
+    targets = np.random.default_rng(5).uniform(-3.0, 3.0, size=(5000, 2))
+    first = _programs_during(lambda: ik.solve_batch(arm, targets[:2000], start, stall_tol=0))
+    assert len([name for name in first if "queue" in name]) == 1, first
+    whole = None
+
+    def second():
+        nonlocal whole
+        whole = ik.solve_batch(arm, targets, start, stall_tol=0)
+    assert [name for name in _programs_during(second) if "queue" in name] == []
+    for k in (0, 1999, 4999):
+        one = ik.solve(arm, targets[k], start, stall_tol=0)
+        assert (one.status, one.iterations) == (whole.status[k], whole.iterations[k])

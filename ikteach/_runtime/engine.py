@@ -112,11 +112,20 @@ def _select(mask, a, b):
         lambda x, y: jnp.where(mask.reshape(mask.shape + (1,) * (x.ndim - 1)), x, y), a, b)
 
 
-def bucket(count):
+def bucket(count, queued=False):
     """The row count a batch of `count` rows is padded to: the next power of two, at least
     MIN_BUCKET. Batches of 9, 10 or 16 rows then share one program, 257 and 500 another; the
-    padded rows are idle slots, never solved."""
-    return max(MIN_BUCKET, 1 << (int(count) - 1).bit_length())
+    padded rows are idle slots, never solved.
+    queued: a CPU queue's rows, SLOTS in flight (in_flight). Past SLOTS rows the padding is
+    never loaded into a slot, so it costs memory only: the bucket is then the next SLOTS x 8^k
+    (8,192, 65,536, 524,288, ...), and the 128 x 128 and 256 x 256 maps share one program."""
+    size = max(MIN_BUCKET, 1 << (int(count) - 1).bit_length())
+    if not queued or size <= SLOTS:
+        return size
+    size = SLOTS
+    while size < count:
+        size *= 8
+    return size
 
 
 def _queue(step, start, args, rows, starts, count, slots):
@@ -264,12 +273,12 @@ def run_rows(fn, shared, rows, few=8, many=SLOTS):
 def run_queue(step, start, args, rows, starts):
     """Final states of every row (numpy), through one path for one device or several (a
     jax.sharding mesh, _run_queue). Device k of D takes rows k, k + D, k + 2D, ... (neighbouring
-    rows cost alike, so the shares take about as long); each share is padded to bucket(share),
-    so batches of nearby sizes share one program."""
+    rows cost alike, so the shares take about as long); each share is padded to bucket(share)
+    (coarser past SLOTS rows on a CPU), so batches of nearby sizes share one program."""
     count, args = starts.shape[0], as_data(args)
     devices = split_devices(count) or tuple(jax.local_devices()[:1])
     d = len(devices)
-    share = bucket(-(-count // d))
+    share = bucket(-(-count // d), queued=devices[0].platform == "cpu")
     order = np.minimum(np.arange(d)[:, None] + d * np.arange(share)[None, :], count - 1).ravel()
     counts = np.array([len(range(k, count, d)) for k in range(d)], dtype=np.int64)
     take = lambda x: np.asarray(x)[order]
