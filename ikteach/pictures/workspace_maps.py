@@ -114,6 +114,7 @@ def reach_scene(arm, theta, reach_map, step, hide=None):
     pv = scene._pv()
     p = scene.scene(arm, theta, window_size=(640, 480))
     keep = np.ones(len(reach_map.points), bool) if hide is None else ~np.asarray(hide)
+    shown = []
     for name, colour in STATUS_COLORS.items():
         chosen = keep & (reach_map.status == name)
         if chosen.any():
@@ -122,14 +123,12 @@ def reach_scene(arm, theta, reach_map, step, hide=None):
                 geom=pv.Sphere(radius=size, theta_resolution=10, phi_resolution=10),
                 scale=False, orient=False)
             p.add_mesh(dots, color=colour, render=False)
-    shown = ", ".join(f"{int(np.sum(keep & (reach_map.status == s)))} {s} "
-                      f"({STATUS_COLOR_NAMES[s]})" for s in STATUS_COLORS
-                      if np.any(keep & (reach_map.status == s)))
+            shown.append(f"{int(chosen.sum())} {name} ({STATUS_COLOR_NAMES[name]})")
     eye, focus, up = p.camera_position  # scene's view, moved onto the grid's centre, wider
     centre = reach_map.points[keep].mean(axis=0)
     p.camera_position = [tuple(np.add(eye, centre - focus)), tuple(centre), up]
     p.camera.zoom(0.8)
     p._ikteach_alt = (f"{scene.describe(arm, theta)[:-1]}; around it {int(keep.sum())} of the "
-                      f"{len(keep)} grid points {step:g} apart as spheres by status: {shown}; "
+                      f"{len(keep)} grid points {step:g} apart as spheres by status: {', '.join(shown)}; "
                       "reached points large, the others small.")
     return p
