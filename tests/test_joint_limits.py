@@ -86,7 +86,9 @@ def test_wide_limits_change_nothing():
         np.testing.assert_array_equal(wide.trace.theta, free.trace.theta)
 
 
-def test_new_limits_do_not_recompile(caplog):
+def test_new_limits_do_not_recompile(caplog, monkeypatch):
+    # the bound on compiled programs may clear JAX's caches between the two solves: off here
+    monkeypatch.setenv("IKTEACH_MAX_PROGRAMS", "0")
     arm, target = ik.planar_chain([1.0, 1.0, 1.0]), [1.2, 1.9]
     ik.solve(arm, target, np.zeros(3), joint_limits=([-0.4, -2, -0.2], [0.1, 0.4, 2]))  # stalls too
     with jax.log_compiles(True), caplog.at_level(logging.DEBUG):
