@@ -5,8 +5,8 @@ on a busy 2-core machine varies by a second). Kernel start-up included.
 
     .venv/bin/python benchmarks/notebook_times.py [notebooks/0*.ipynb ...]
 
-Goals (issue 31): each lecture notebook < 10 s cold and < 5 s with the cache warm on a quiet
-2-core machine, all ten < 60 s cold.
+Goals (issue 38): each lecture notebook < 10 s cold and < 5 s with the cache warm on a quiet
+2-core machine, all ten < 45 s cold.
 """
 import argparse
 import os
@@ -22,7 +22,7 @@ from nbclient import NotebookClient
 from ikteach.course.notebook import CACHE_ENV
 
 ROOT = Path(__file__).resolve().parents[1]
-COLD_GOAL_S, WARM_GOAL_S, TOTAL_COLD_GOAL_S = 10.0, 5.0, 60.0
+COLD_GOAL_S, WARM_GOAL_S, TOTAL_COLD_GOAL_S = 10.0, 5.0, 45.0
 WARM_RUNS = 3
 
 

@@ -86,6 +86,23 @@ def test_jit_takes_decorator_arguments_and_keeps_the_function():
     assert np.isfinite(ik.solve(ik.planar_chain([1.0, 1.0]), [1.0, 1.0], [0.1, 0.2]).error)
 
 
+def test_quick_jit_runs_alone_inside_a_trace_and_keeps_its_own_errors():
+    import jax
+    import pytest
+
+    arm, q = ik.planar_chain([1.0, 0.5, 0.25]), np.array([0.3, -0.2, 0.4])
+    alone = np.asarray(ik.fk(arm, q))  # compiled with the options
+    assert ik.fk.__wrapped__.__name__ == "fk" and ik.fk.__module__ == "ikteach.core.kinematics"
+    assert isinstance(ik.fk, xla.QuickProgram) and isinstance(ik.jacobian, xla.QuickProgram)
+    # inside another program: traced (inlined), and with constants only (no options there)
+    assert np.asarray(jax.jit(lambda t: ik.fk(arm, t))(q)).tobytes() == alone.tobytes()
+    np.testing.assert_array_equal(jax.jit(lambda: ik.fk(arm, q))(), alone)
+    np.testing.assert_allclose(jax.jacfwd(lambda t: ik.fk(arm, t))(q), ik.jacobian(arm, q),
+                               atol=1e-12)
+    assert ik.jacobian(arm, q, full=True).shape == (3, 3)  # a static argument
+    with pytest.raises(ValueError, match="theta: expected shape"):
+        ik.fk(arm, np.zeros(4))
+
 
 def test_past_the_bound_the_caches_are_cleared_and_results_stay_the_same(monkeypatch):
     """The program bound: past max_programs() distinct programs JAX's caches are cleared; the

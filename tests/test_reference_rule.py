@@ -149,7 +149,8 @@ def planar_jacobian(lengths, theta):
 
 def by_hand():
     """ikteach's pinv_step typed into the notebook, names changed: plagiarism, reported."""
-    source = inspect.getsource(pinv.pinv_step.__wrapped__).replace("@jax.jit\n", "")
+    source = "".join(line for line in inspect.getsource(pinv.pinv_step.__wrapped__)
+                     .splitlines(keepends=True) if not line.startswith("@"))  # no decorator
     return ("import numpy as jnp\n\n\n" + source.replace("sigma", "s").replace("rcond=DEFAULT_RCOND", "rcond"))
 
 

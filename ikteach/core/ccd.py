@@ -6,6 +6,7 @@ import jax.numpy as jnp
 from .chain import Chain
 from .kinematics import joint_frames
 from .method import method
+from .._runtime.jit import quick_jit
 
 
 def ccd_angle(z, p, x, t):
@@ -24,7 +25,7 @@ def as_point3(arm, target):
     return jnp.concatenate([target, jnp.zeros(3 - arm.dim)]) if arm.dim == 2 else target
 
 
-@jax.jit
+@quick_jit
 def ccd_sweep(arm, target, theta):
     """One CCD iteration: for i = n-1, ..., 0, theta_i += ccd_angle(z_i, p_i, x_end, target)."""
     t = as_point3(arm, target)

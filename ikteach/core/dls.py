@@ -1,14 +1,14 @@
 """Damped least squares: minimise ||J delta_theta - e||^2 + lambda^2 ||delta_theta||^2."""
-import jax
 import jax.numpy as jnp
 
 from ._validate import as_number
 from .method import JacobianMethod, method, replace
+from .._runtime.jit import quick_jit
 
 DAMPING_PER_LENGTH = 6  # default lambda = L / 6 (0.5 for three unit links; L: the arm's size)
 
 
-@jax.jit
+@quick_jit
 def dls_step(J, e, damping):
     """delta_theta = J^T (J J^T + lambda^2 I)^-1 e: an m x m solve (m = rows of J).
 
@@ -22,7 +22,7 @@ def dls_step(J, e, damping):
     return J.T @ jnp.linalg.solve(J @ J.T + damping**2 * jnp.eye(m), e)
 
 
-@jax.jit
+@quick_jit
 def dls_step_small(J, e, damping):
     """dls_step for J with m <= 3 rows, the m x m inverse in closed form (Cramer's rule):
 
@@ -45,7 +45,7 @@ def dls_step_small(J, e, damping):
     return J.T @ (adj @ e) / jnp.dot(B[0], adj[0])
 
 
-@jax.jit
+@quick_jit
 def dls_step_normal(J, e, damping):
     """The normal equations (J^T J + lambda^2 I) delta_theta = J^T e: an n x n solve."""
     J, e = jnp.asarray(J), jnp.asarray(e)

@@ -25,6 +25,7 @@ import jax.numpy as jnp
 from .ccd import as_point3, ccd_angle
 from .kinematics import joint_frames
 from .method import method
+from .._runtime.jit import quick_jit
 
 EPS = 1e-12  # relative: two points closer than EPS times the link length count as one
 
@@ -67,7 +68,7 @@ def fabrik_stretch(points, lengths, target):
     return jax.lax.fori_loop(0, lengths.shape[0], straighten, points)
 
 
-@jax.jit
+@quick_jit
 def fabrik_pass(points, lengths, target):
     """One FABRIK iteration on the points (stretch when the target is out of reach)."""
     points, lengths, target = jnp.asarray(points), jnp.asarray(lengths), jnp.asarray(target)

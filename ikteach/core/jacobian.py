@@ -5,9 +5,10 @@ import jax
 import jax.numpy as jnp
 
 from .kinematics import fk, joint_frames
+from .._runtime.jit import quick_jit
 
 
-@partial(jax.jit, static_argnames="full")
+@partial(quick_jit, static_argnames="full")
 def jacobian(arm, theta, full=False):
     """Geometric Jacobian: column i is z_i x (p_e - p_i), z_i joint i's unit axis.
 
@@ -28,13 +29,13 @@ def jacobian_from_frames(arm, positions, axes, full=False):
     return jnp.vstack([linear, axes.T])
 
 
-@jax.jit
+@quick_jit
 def jacobian_autodiff(arm, theta):
     """J = dF/dtheta by forward-mode automatic differentiation (jax.jacfwd of fk)."""
     return jax.jacfwd(lambda t: fk(arm, t))(jnp.asarray(theta, dtype=float))
 
 
-@jax.jit
+@quick_jit
 def jacobian_fd(arm, theta, h=1e-6):
     """J by central differences: column i = (F(theta + h e_i) - F(theta - h e_i)) / 2h."""
     theta = jnp.asarray(theta, dtype=float)

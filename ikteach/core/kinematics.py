@@ -2,6 +2,7 @@
 import jax
 import jax.numpy as jnp
 import numpy as np
+from .._runtime.jit import quick_jit
 
 
 def skew(omega):
@@ -16,7 +17,7 @@ def rotation_about(axis, angle):
     return jnp.eye(3) + jnp.sin(angle) * K + (1.0 - jnp.cos(angle)) * (K @ K)
 
 
-@jax.jit
+@quick_jit
 def joint_frames(arm, theta):
     """World positions p_1..p_n of the joints and p_e of the end effector (rows 0..n: row i-1
     is p_i, p_1 the base), world axes z_1..z_n (row i-1 is z_i) and the end effector's rotation R.
@@ -42,13 +43,13 @@ def joint_frames(arm, theta):
     return jnp.vstack([base[None], positions]), axes, R
 
 
-@jax.jit
+@quick_jit
 def joint_positions(arm, theta):
     """Base, every joint and the end effector: shape (n + 1, d)."""
     return joint_frames(arm, theta)[0][:, : arm.dim]
 
 
-@jax.jit
+@quick_jit
 def fk(arm, theta):
     """End-effector position x = F(theta): shape (d,)."""
     return joint_frames(arm, theta)[0][-1, : arm.dim]

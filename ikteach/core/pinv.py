@@ -1,14 +1,14 @@
 """Pseudoinverse step by the SVD, with a cut-off for small singular values."""
-import jax
 import jax.numpy as jnp
 
 from ._validate import as_number
 from .method import JacobianMethod, method
+from .._runtime.jit import quick_jit
 
 DEFAULT_RCOND = 1e-6
 
 
-@jax.jit
+@quick_jit
 def pinv_step(J, e, rcond=DEFAULT_RCOND):
     """delta_theta = J^+ e = sum_i (u_i . e / sigma_i) v_i over sigma_i >= rcond * sigma_max.
 
@@ -22,7 +22,7 @@ def pinv_step(J, e, rcond=DEFAULT_RCOND):
     return Vt.T @ (inv_sigma * (U.T @ e))
 
 
-@jax.jit
+@quick_jit
 def pinv_two_rows(J, e, rcond=DEFAULT_RCOND):
     """pinv_step for a 2 x n Jacobian (planar position targets) without an SVD call.
 

@@ -28,6 +28,7 @@ from ._validate import as_array, as_number
 from .chain import Chain, reach
 from .jacobian import jacobian
 from .kinematics import joint_frames, skew
+from .._runtime.jit import quick_jit
 
 # Below sin^2(angle) = SMALL the log uses its Taylor series; above cos(angle) = NEAR_PI
 # the axis is read from the symmetric part of R. Both branches are exact to float64.
@@ -35,7 +36,7 @@ SMALL = 1e-6
 NEAR_PI = -0.9
 
 
-@jax.jit
+@quick_jit
 def fk_pose(arm, theta):
     """Forward kinematics as a 4x4 homogeneous transform T = [[R, p], [0, 0, 0, 1]]."""
     positions, _, R = joint_frames(arm, theta)
@@ -43,7 +44,7 @@ def fk_pose(arm, theta):
     return jnp.vstack([top, jnp.array([[0.0, 0.0, 0.0, 1.0]])])
 
 
-@jax.jit
+@quick_jit
 def rotation_exp(omega):
     """Rodrigues' formula for a rotation vector: exp([w]x) = I + sinc(t)[w]x + (1-cos t)/t^2 [w]x^2,
     t = |w|; the two coefficients use their Taylor series near t = 0 (finite gradient at 0)."""
@@ -57,7 +58,7 @@ def rotation_exp(omega):
     return jnp.eye(3) + a * K + b * (K @ K)
 
 
-@jax.jit
+@quick_jit
 def rotation_log(R):
     """The rotation vector omega = angle * axis of a rotation matrix, angle in [0, pi].
 

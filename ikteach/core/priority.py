@@ -12,11 +12,12 @@ import jax
 import jax.numpy as jnp
 
 from ._validate import as_array, as_number
+from .._runtime.jit import quick_jit
 
 RANK_RCOND = 1e-10  # singular values below RANK_RCOND * sigma_max count as zero (the null space)
 
 
-@jax.jit
+@quick_jit
 def damped_pinv(A, damping, scale=None):
     """A's damped pseudoinverse V diag(sigma / (sigma^2 + lambda^2)) U^T = A^T (A A^T + lambda^2 I)^-1.
 
@@ -30,7 +31,7 @@ def damped_pinv(A, damping, scale=None):
     return Vt.T @ (inv[:, None] * U.T)
 
 
-@jax.jit
+@quick_jit
 def null_projector(A):
     """N = I - A+ A: projects onto the null space of A (A N = 0), from A's SVD."""
     _, sigma, Vt = jnp.linalg.svd(A, full_matrices=True)
@@ -81,7 +82,7 @@ def _check_levels(J1, e1, J2, e2, damping):
     return tuple(jnp.asarray(x, dtype=float) for x in (J1, e1, J2, e2))
 
 
-@jax.jit
+@quick_jit
 def multilevel_step(levels, damping):
     """delta for levels [(J_1, e_1), (J_2, e_2), ...], level k solved in the null space of
     the stacked Jacobians of levels 1..k-1:  delta_k = delta_{k-1} + N_{<k} (J_k N_{<k})+ (e_k - J_k delta_{k-1})."""

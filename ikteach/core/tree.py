@@ -17,6 +17,7 @@ import numpy as np
 from ._validate import as_array
 from .chain import check_link_lengths
 from .kinematics import rotation_about
+from .._runtime.jit import quick_jit
 
 
 @dataclasses.dataclass(frozen=True)
@@ -122,7 +123,7 @@ def level_table(parents):
     return levels[0], joints, ups
 
 
-@jax.jit
+@quick_jit
 def tree_frames(arm, theta):
     """World joint positions (n, 3), world axes (n, 3) and effector positions (m, 3).
 
@@ -162,13 +163,13 @@ def tree_frames(arm, theta):
     return p[:n], z[:n], x
 
 
-@jax.jit
+@quick_jit
 def tree_fk(arm, theta):
     """End-effector positions x_k = F_k(theta): shape (m, 3)."""
     return tree_frames(arm, theta)[2]
 
 
-@jax.jit
+@quick_jit
 def tree_jacobian(arm, theta):
     """The stacked Jacobian, one block of 3 rows per end effector: shape (3m, n).
 
@@ -184,7 +185,7 @@ def tree_jacobian_from_frames(arm, p, z, x):
     return jnp.transpose(blocks, (0, 2, 1)).reshape(3 * arm.n_effectors, arm.n_joints)
 
 
-@jax.jit
+@quick_jit
 def tree_jacobian_autodiff(arm, theta):
     """The stacked Jacobian by jax.jacfwd of the flattened effector positions, for checking."""
     return jax.jacfwd(lambda t: tree_fk(arm, t).reshape(-1))(jnp.asarray(theta, dtype=float))
