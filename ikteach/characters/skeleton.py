@@ -14,6 +14,7 @@ import numpy as np
 
 from ..core._validate import as_array
 from ..core.tree import tree, tree_fk
+from .._runtime.jit import quick_jit
 
 AXES = {"Xrotation": (1.0, 0.0, 0.0), "Yrotation": (0.0, 1.0, 0.0), "Zrotation": (0.0, 0.0, 1.0)}
 ROTATIONS = ("Xrotation", "Yrotation", "Zrotation")
@@ -204,7 +205,7 @@ def frames_from(rig, root, theta, like):
     return out
 
 
-@jax.jit
+@quick_jit
 def _points(arm, root, theta):
     return root[:, None, :] + jax.vmap(lambda q: tree_fk(arm, q))(theta)
 

@@ -1,12 +1,12 @@
 """Jacobian transpose: step along the gradient of 1/2 ||e||^2 with Buss's optimal alpha."""
-import jax
 import jax.numpy as jnp
 
 from ikteach.core._validate import as_number  # absolute: the self-check runs this file as a cell
 from ikteach.core.method import JacobianMethod, method
+from ikteach._runtime.jit import quick_jit  # absolute, as above
 
 
-@jax.jit
+@quick_jit
 def optimal_alpha(J, e):
     """alpha = <e, J J^T e> / <J J^T e, J J^T e>, the alpha minimising ||e - alpha J J^T e||.
 
@@ -18,7 +18,7 @@ def optimal_alpha(J, e):
     return jnp.where(vv > 0, jnp.dot(e, v) / jnp.where(vv > 0, vv, 1.0), 0.0)
 
 
-@jax.jit
+@quick_jit
 def jt_step(J, e):
     """Jacobian-transpose step: delta_theta = alpha J^T e, alpha from optimal_alpha."""
     J, e = jnp.asarray(J), jnp.asarray(e)

@@ -58,7 +58,7 @@ def fk(arm, theta):
 PATH_CHUNK = 128  # end_path works in blocks of this many rows: one compile per arm shape
 
 
-@jax.jit
+@quick_jit
 def _end_block(arm, thetas):
     return jax.vmap(lambda q: fk(arm, q))(thetas)
 

@@ -15,6 +15,7 @@ from .kinematics import end_path  # noqa: F401  (ws.end_path, used by the notebo
 from .jitter import jitter_per_step
 from .solve import status_counts
 from .track import track as follow
+from .._runtime.jit import quick_jit
 
 @dataclasses.dataclass(frozen=True)
 class Grid:
@@ -81,7 +82,7 @@ def sweep(arm, grid, theta0, method="dls", **kwargs):
                     grid.image(res.theta), grid.image(res.error))
 
 
-@jax.jit
+@quick_jit
 def _sigma_min(arm, thetas):
     return jax.vmap(lambda q: jnp.linalg.svd(jacobian(arm, q), compute_uv=False)[-1])(thetas)
 
