@@ -1,5 +1,6 @@
-"""jax.jit for the course's whole-loop programs, on JAX's public API, with three choices that
-buy speed and can each be turned off without changing a result.
+"""jax.jit for the course's programs (the whole loops, and the small functions lectures call on
+their own: quick_jit), on JAX's public API, with three choices that buy speed and can each be
+turned off without changing a result.
 
 1. XLA's classic CPU emitters (`compiler_options`, a public argument of jax.jit). The newer
    "fusion emitters" build one LLVM module per fused kernel; for the course's loops (a few
