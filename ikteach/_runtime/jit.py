@@ -109,11 +109,18 @@ def keep_within_bound():
         clears[0] += 1
 
 
+def jax_jit(fun, static_argnames, options):
+    """jax.jit(fun) with these compiler options (None: none); static_argnames a name or names."""
+    names = (static_argnames,) if isinstance(static_argnames, str) else tuple(static_argnames)
+    kwargs = {"compiler_options": options} if options else {}
+    return jax.jit(fun, static_argnames=names, **kwargs)
+
+
 class Program:
     """A jitted whole-loop program, run within the bound on compiled programs."""
 
     def __init__(self, fun, static_argnames=(), fast_compile=True, light=False):
-        self.fun, self.static_argnames, self.fast_compile = fun, tuple(static_argnames), fast_compile
+        self.fun, self.static_argnames, self.fast_compile = fun, static_argnames, fast_compile
         self.light = light
         self._jitted = None
         functools.update_wrapper(self, fun)
@@ -121,8 +128,7 @@ class Program:
     def jitted(self):
         if self._jitted is None:
             options = compiler_options(self.light) if self.fast_compile else None
-            kwargs = {"compiler_options": options} if options else {}
-            self._jitted = jax.jit(self.fun, static_argnames=self.static_argnames, **kwargs)
+            self._jitted = jax_jit(self.fun, self.static_argnames, options)
         return self._jitted
 
     def clear_cache(self):
@@ -153,16 +159,13 @@ class QuickProgram:
     program is traced)."""
 
     def __init__(self, fun, static_argnames=()):
-        if isinstance(static_argnames, str):
-            static_argnames = (static_argnames,)
-        self.fun, self.static_argnames, self._jitted = fun, tuple(static_argnames), {}
+        self.fun, self.static_argnames, self._jitted = fun, static_argnames, {}
         functools.update_wrapper(self, fun)
 
     def jitted(self, quick):
         if quick not in self._jitted:
             options = compiler_options() if quick else None
-            kwargs = {"compiler_options": options} if options else {}
-            self._jitted[quick] = jax.jit(self.fun, static_argnames=self.static_argnames, **kwargs)
+            self._jitted[quick] = jax_jit(self.fun, self.static_argnames, options)
         return self._jitted[quick]
 
     def __call__(self, *args, **kwargs):
