@@ -131,26 +131,31 @@ def gains(start, end, visible):
 
 def probe(problem, theta, levels, free, lower, upper, sigma_max, slack):
     """Up to PROBE_STEPS light priority steps from theta, each kept only when it helps
-    (module doc); returns where the probe ends and its level norms."""
-    def light_step(q, damping):
-        e, J = problem.error(q), problem.jacobian(q) * free
+    (module doc); returns where the probe ends and its level norms. Each step walks the arm
+    once, at its trial point: e and J there are kept with it (a refused trial leaves q, its e
+    and its J as they were)."""
+    def light_step(e, J, damping):
+        J = J * free
         if len(levels) == 1:  # one level: the DLS step (as multilevel_step, without its SVD)
             step = damped_step(J[jnp.asarray(levels[0])], e[jnp.asarray(levels[0])], damping)
         else:
             step = multilevel_step([(J[jnp.asarray(r)], e[jnp.asarray(r)]) for r in levels], damping)
         return cap_step(step, PROBE_MAX_TURN)
 
-    start = level_norms(problem.error(theta), levels)
+    e, J = problem.error_and_jacobian(theta)
+    start = level_norms(e, levels)
 
     def one(_, carry):
-        q, norms, f = carry
-        trial = jnp.clip(q + light_step(q, f * sigma_max), lower, upper)
-        trial_norms = level_norms(problem.error(trial), levels)
+        q, e, J, norms, f = carry
+        trial = jnp.clip(q + light_step(e, J, f * sigma_max), lower, upper)
+        trial_e, trial_J = problem.error_and_jacobian(trial)
+        trial_norms = level_norms(trial_e, levels)
         kept = helps(start, norms, trial_norms, slack)
-        return (jnp.where(kept, trial, q), jnp.where(kept, trial_norms, norms),
-                jnp.where(kept, f / PROBE_LIGHTER, f * PROBE_HEAVIER))
+        keep = lambda new, old: jnp.where(kept, new, old)
+        return (keep(trial, q), keep(trial_e, e), keep(trial_J, J), keep(trial_norms, norms),
+                keep(f / PROBE_LIGHTER, f * PROBE_HEAVIER))
 
-    end, norms, _ = jax.lax.fori_loop(0, PROBE_STEPS, one, (theta, start, PROBE_DAMPING))
+    end, _, _, norms, _ = jax.lax.fori_loop(0, PROBE_STEPS, one, (theta, e, J, start, PROBE_DAMPING))
     return end, norms
 
 
