@@ -318,3 +318,10 @@ def test_quick_jit_is_explained_before_a_lecture_first_prints_it(path):
         if re.search(r"^@(partial\()?quick_jit", shown, flags=re.M):
             assert said, f"{path.name}: prints @quick_jit before a Markdown cell says what it is"
             return
+
+
+def test_every_lecture_title_is_written_the_same_way():
+    """'# NN — Title' (one dash for the menu, the home page and the slides index alike)."""
+    for path in (p for p in NOTEBOOKS if p.parent.name == "notebooks"):
+        first = "".join(next(c for c in _load(path)["cells"] if c["cell_type"] == "markdown")["source"])
+        assert re.match(rf"# {path.name[:2]} — \S", first), (path.name, first.splitlines()[0])

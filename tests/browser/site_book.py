@@ -119,6 +119,19 @@ for (const cell of document.querySelectorAll('.bd-article td, .bd-article th')) 
 return found;"""
 
 
+# Typeset math in the page's contents column (the headings) shrunk below readable size: a long
+# formula in a heading is scaled to the column's width (lecture 04's identity was 6 px tall).
+TINY_CONTENTS_MATH = """
+return [...document.querySelectorAll('.bd-sidebar-secondary mjx-container svg')]
+  .filter(s => s.getClientRects().length && s.getBoundingClientRect().height < 9)
+  .map(s => `${Math.round(s.getBoundingClientRect().height)} px: ${s.closest('a')?.innerText.slice(0, 30)}`);"""
+
+# More than one search field on screen (the header's and the menu's).
+SEARCH_FIELDS = """
+return [...document.querySelectorAll('.search-button-field')]
+  .filter(e => e.getClientRects().length && !e.closest('dialog:not([open])')).length;"""
+
+
 def overflow(driver):
     """How many CSS pixels the page is wider than the screen (0: it fits)."""
     return driver.execute_script(
@@ -153,7 +166,9 @@ def check_pages(driver, site, pages, width):
                  "axe": axe_violations(driver)[:2],
                  "headings larger than a higher rank": driver.execute_script(HEADINGS_OUT_OF_RANK)[:2],
                  "wider than the screen by (px)": overflow(driver),
-                 "table words wider than their cell": driver.execute_script(TABLE_WORDS_TOO_WIDE)[:3]}
+                 "table words wider than their cell": driver.execute_script(TABLE_WORDS_TOO_WIDE)[:3],
+                 "formulas in the contents under 9 px": driver.execute_script(TINY_CONTENTS_MATH)[:2],
+                 "search fields on screen beyond one": max(0, driver.execute_script(SEARCH_FIELDS) - 1)}
         problems += [f"{page} at {width}: {what}: {value}" for what, value in found.items() if value]
         if page in SHOT_PAGES:
             shoot(driver, f"site-{SHOT_PAGES[page]}-{width}.png")
