@@ -47,5 +47,6 @@ html_theme_options = {
     "use_repository_button": True,
     "use_download_button": False,
     "show_toc_level": 2,
+    "navbar_persistent": [],  # one search field (the menu's), not a second one in the header
 }
 smartquotes = False  # the notebooks' text as written

@@ -50,8 +50,8 @@ def test_clamp_growth_needs_a_clamp_and_a_bool():
 
 @pytest.mark.parametrize("label", ["DLS", "SDLS", "DLS + clamp"])
 def test_several_paths_at_once_follow_each_path_as_alone(label):
-    """targets (P, T, ...): every path tracked side by side in one program, each as if alone
-    (the same steps; vectorised arithmetic may round the last bits differently)."""
+    """targets (P, T, ...): every path tracked side by side in one program, the same steps as alone
+    up to the last bits (vectorised arithmetic may round them differently; a chaotic run grows them)."""
     tree, kw = bt.y_tree(), bt.demo_methods("y")[label]
     paths = np.stack([bt.y_targets(t0 + bt.times(200)) for t0 in (0.0, 10.0, 20.0)])
     starts = np.random.default_rng(2).uniform(-0.1, 0.1, (3, tree.n_joints))

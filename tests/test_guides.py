@@ -149,3 +149,32 @@ def test_guide_links_point_at_files():
         for target in re.findall(r"\]\(([^)#\s]+)(?:#[^)]*)?\)", path.read_text(encoding="utf-8")):
             if not re.match(r"[a-z]+:", target):
                 assert (path.parent / target).exists(), f"{path.name}: {target}"
+
+
+def unfinished_paragraphs(text):
+    """The last lines of prose paragraphs that end without closing punctuation: a sentence cut
+    off (a paragraph that introduces a code block or a table may end as it likes)."""
+    blocks = [b.strip("\n") for b in re.split(r"\n[ \t]*\n", text)]
+    cut, fence = [], False
+    for block, after in zip(blocks, blocks[1:] + [""]):
+        if block.count("```") % 2:
+            fence = not fence
+        if fence or "```" in block or not block.strip():
+            continue
+        last = block.splitlines()[-1].strip()
+        if last.startswith(("|", "#", "<", "![", "[")) or after.lstrip().startswith(("```", "|")) \
+                or after.startswith("    "):
+            continue
+        if not re.search(r"[.:;!?)`*>\]]$", last):
+            cut.append(last)
+    return cut
+
+
+@pytest.mark.parametrize("guide", GUIDES + [ROOT / "notebooks" / "README.md"], ids=lambda p: p.name)
+def test_no_guide_stops_mid_sentence(guide):
+    assert unfinished_paragraphs(guide.read_text(encoding="utf-8")) == []
+
+
+def test_a_sentence_cut_off_is_caught():
+    assert unfinished_paragraphs("Say what is wrong (NaN near a\n\nNext paragraph.\n") == ["Say what is wrong (NaN near a"]
+    assert unfinished_paragraphs("Run\n\n```\nmake site\n```\n") == []

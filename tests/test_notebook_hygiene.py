@@ -284,3 +284,44 @@ def test_every_notebook_links_the_one_notation_table(path):
     table = (path.parent / link).resolve()
     assert table == ROOT / "notebooks" / "README.md"
     assert '<a id="notation"></a>' in table.read_text(encoding="utf-8")
+
+
+def _math(path):
+    """The LaTeX in a notebook's Markdown cells ($...$ and $$...$$), one string."""
+    cells = _load(path)["cells"]
+    text = "\n".join("".join(c["source"]) for c in cells if c["cell_type"] == "markdown")
+    return " ".join(re.findall(r"\$\$?(.+?)\$\$?", text, flags=re.S))
+
+
+# the notation table's "one meaning each" for letters once used twice (issue 49, item 10)
+ONE_MEANING = {"g": {"02_jacobian_transpose"}, "A": {"10_redundancy", "07_priority_step"},
+               "C": {"05_singularities_out_of_reach"}, r"\\kappa": {"10_redundancy"}}
+
+
+@pytest.mark.parametrize("symbol", ONE_MEANING)
+def test_a_letter_with_one_meaning_is_written_only_where_the_table_says(symbol):
+    pattern = re.compile(rf"(?<![\\A-Za-z]){symbol}(?![A-Za-z])")
+    used = {p.stem for p in NOTEBOOKS if pattern.search(_math(p))}
+    assert used <= ONE_MEANING[symbol] and used, (symbol, used)
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.relative_to(ROOT).as_posix())
+def test_quick_jit_is_explained_before_a_lecture_first_prints_it(path):
+    """One decorator in printed source (`@quick_jit`, never a bare jax.jit), and a word on it before it shows."""
+    said = False
+    for cell in _load(path)["cells"]:
+        if cell["cell_type"] == "markdown":
+            said = said or "`@quick_jit`" in "".join(cell["source"])
+            continue
+        shown = "".join("".join(o.get("text", "")) for o in cell.get("outputs", []))
+        assert not re.search(r"^@(functools\.)?(partial\()?jax\.jit", shown, flags=re.M), path.name
+        if re.search(r"^@(partial\()?quick_jit", shown, flags=re.M):
+            assert said, f"{path.name}: prints @quick_jit before a Markdown cell says what it is"
+            return
+
+
+def test_every_lecture_title_is_written_the_same_way():
+    """'# NN — Title' (one dash for the menu, the home page and the slides index alike)."""
+    for path in (p for p in NOTEBOOKS if p.parent.name == "notebooks"):
+        first = "".join(next(c for c in _load(path)["cells"] if c["cell_type"] == "markdown")["source"])
+        assert re.match(rf"# {path.name[:2]} — \S", first), (path.name, first.splitlines()[0])

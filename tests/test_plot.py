@@ -80,6 +80,19 @@ def test_animate_race_draws_every_method_and_embeds_under_the_limit():
     assert len(html.encode()) < 4 * 2**20
 
 
+def test_a_race_shares_one_scale_shows_ticks_and_grows_its_error_curves():
+    results = {m: ik.solve(ARM, [3.5, 1.0], START, method=m, max_iter=60) for m in ("jt", "pinv", "dls")}
+    anim = plot.animate_race(ARM, results, [3.5, 1.0], max_frames=6)
+    arms, errors = anim._fig.axes[:3], anim._fig.axes[3]
+    assert len({(ax.get_xlim(), ax.get_ylim()) for ax in arms}) == 1  # the same pose, the same size
+    assert all(len(ax.get_xticks()) > 1 and len(ax.get_yticks()) > 1 for ax in arms)
+    curves = errors.get_lines()[: len(results)]
+    for j, k in enumerate(anim.iterations):
+        anim.draw_frame(j)
+        for curve, res in zip(curves, results.values()):
+            assert len(curve.get_xdata()) == min(k, res.iterations) + 1
+
+
 def test_plot_errors_draws_one_curve_per_result():
     fig, ax = plt.subplots()
     results = {m: ik.solve(ARM, [2.5, 0.5], START, method=m) for m in ("pinv", "dls")}

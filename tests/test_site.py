@@ -223,6 +223,7 @@ def test_the_home_page_shows_one_column_of_the_lectures_table():
     assert len(lines) == len(book.lectures(ROOT))
     for name, line in lines.items():
         assert " | " not in line and "core/" not in line, f"{name}: {line}"
+        assert "_" not in re.sub(r"`[^`]*`", "", line), f"{name}: a raw subscript ('p_e') on the home page: {line}"
 
 
 def test_the_notation_table_shows_subscripts_as_written(site):

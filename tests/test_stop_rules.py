@@ -81,6 +81,16 @@ def test_a_singular_start_says_so_and_a_nudge_gets_going(method):
     assert ik.solve(arm, [2.0, 0.0], [0.0, 0.1, 0.0], method=method).converged
 
 
+@pytest.mark.parametrize("method", ["jt", "pinv", "dls", "sdls"])
+def test_singular_says_nothing_about_reach(method):
+    """The same saddle with the target behind the arm, 2 beyond its reach (the status glossary)."""
+    arm = ik.planar_chain([1.0] * 3)
+    behind = ik.solve(arm, [-5.0, 0.0], np.zeros(3), method=method)
+    assert (behind.status, behind.iterations, behind.error) == ("singular", 1, 8.0), behind
+    nudged = ik.solve(arm, [-5.0, 0.0], [0.0, 0.1, 0.0], method=method)
+    assert not nudged.converged and nudged.error > 2.0 - 1e-3, nudged
+
+
 @pytest.mark.parametrize("kw", [dict(damping=1e3), dict(max_step=1e-6)])
 def test_steps_cut_to_nothing_by_damping_or_caps_say_damped(kw):
     res = ik.solve(ik.planar_chain([1.0] * 3), REACHABLE, START, **kw)

@@ -28,6 +28,7 @@ import numpy as np
 from ._validate import as_number
 from .method import JacobianMethod, method
 from .safeguards import cap_step
+from .._runtime.jit import quick_jit
 
 GAMMA_MAX = np.pi / 4   # Buss & Kim 2005, section 4
 # Singular values below NEAR_ZERO sigma_max are skipped. Buss's demo code skips those below
@@ -62,7 +63,7 @@ def soft_rescale(w, gamma):
     return w * (gamma / (gamma + jnp.max(jnp.abs(w))))
 
 
-@functools.partial(jax.jit, static_argnames=("block", "soft"))
+@functools.partial(quick_jit, static_argnames=("block", "soft"))
 def sdls_step(J, e, gamma_max=GAMMA_MAX, block=None, soft=False):
     """delta_theta = ClampMaxAbs(sum_i ClampMaxAbs((u_i.e / sigma_i) v_i, gamma_i), gamma_max).
 

@@ -5,11 +5,11 @@ toward the target: there every column of J is tangential, e = d r (r the radial 
 is orthogonal to J's range, so J^T e = 0 and the step is 0. Near it, for a small joint
 deviation delta, the DLS step is linear in delta:
 
-    delta <- M delta,   M = (J^T J + lambda^2 I)^-1 (lambda^2 I - d A),
+    delta <- M delta,   M = (J^T J + lambda^2 I)^-1 (lambda^2 I - d C),
 
-where A_ij = sum of the lengths of links k >= max(i, j) (-A is the Hessian of r^T F, the tip's
+where C_ij = sum of the lengths of links k >= max(i, j) (-C is the Hessian of r^T F, the tip's
 reach along r, at the stretched pose; the Hessian of the tip's distance from the base is
-J^T J / L - A, L the reach: lecture 05). DLS settles (the step shrinks, the stall rule fires:
+J^T J / L - C, L the reach: lecture 05). DLS settles (the step shrinks, the stall rule fires:
 "stalled") when the spectral radius of M is below 1; otherwise the stretched pose repels it and
 it runs to max_iter, swinging about that pose when lambda is just below the threshold or
 wandering far from it, even folding up, when lambda is small (lecture 04). This linear model
@@ -29,24 +29,24 @@ def _lengths(arm):
 
 
 def stretched_matrices(arm):
-    """(J^T J, A) at the stretched pose, in the frame of the stretch direction."""
+    """(J^T J, C) at the stretched pose, in the frame of the stretch direction."""
     tail = np.cumsum(_lengths(arm)[::-1])[::-1]  # tail[i] = sum of the lengths of links k >= i
     n = len(tail)
-    A = tail[np.maximum.outer(np.arange(n), np.arange(n))]
-    return np.outer(tail, tail), A
+    C = tail[np.maximum.outer(np.arange(n), np.arange(n))]
+    return np.outer(tail, tail), C
 
 
 def settle_matrix(arm, distance, damping, clamp=None):
     """M, the DLS step's map delta <- M delta near the stretched pose (joint angles).
 
-    Unclamped, J^T e = -(J^T J + d A) delta to first order. Buss's clamp scales e by D / ||e||,
+    Unclamped, J^T e = -(J^T J + d C) delta to first order. Buss's clamp scales e by D / ||e||,
     D = min(d, D_max), and J^T e is already first order, so the step sees D / d of it:
-        M = (J^T J + lambda^2 I)^-1 ((1 - D/d) J^T J + lambda^2 I - D A),
-    which is (J^T J + lambda^2 I)^-1 (lambda^2 I - d A) when the clamp does not act (D = d)."""
+        M = (J^T J + lambda^2 I)^-1 ((1 - D/d) J^T J + lambda^2 I - D C),
+    which is (J^T J + lambda^2 I)^-1 (lambda^2 I - d C) when the clamp does not act (D = d)."""
     D = distance if clamp is None else min(distance, clamp)
-    JtJ, A = stretched_matrices(arm)
-    eye = np.eye(len(A))
-    return np.linalg.solve(JtJ + damping**2 * eye, (1 - D / distance) * JtJ + damping**2 * eye - D * A)
+    JtJ, C = stretched_matrices(arm)
+    eye = np.eye(len(C))
+    return np.linalg.solve(JtJ + damping**2 * eye, (1 - D / distance) * JtJ + damping**2 * eye - D * C)
 
 
 def settle_factor(arm, distance, damping, clamp=None):

@@ -41,7 +41,9 @@ solve has one level, e itself.
                (another start may reach it: a local minimum looks the same from inside);
   SADDLE       "singular": no gain, but H < -CURVATURE_FRACTION sigma_max^2 along some
                direction: a saddle, e.g. a straight arm whose target lies on its own line.
-               Reachable; a nudge of the start gets the solve going;
+               It says nothing about reach (the straight arm (1, 1, 1) at theta = 0 stops
+               "singular" for the target (2, 0) and for (-5, 0), 2 beyond its reach): nudge the
+               start and solve again to learn whether the target is in reach;
   CUT_SHORT    "damped": the probe gains: the method's steps, not the target, stopped the solve
                short of a minimum (a large damping lambda, max_step or clamp for this arm's
                size, a pseudoinverse cut-off, or J's weak direction). Solve again with less damping;

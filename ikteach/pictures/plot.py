@@ -248,6 +248,8 @@ def animate_race(arm, results, target, max_frames=MAX_FRAMES, spacing="log", fig
 
     results maps a label ("jt", "pinv", "dls", ...) to its Result from the same start.
     Frames follow a common iteration counter; a method that has stopped stays at its end.
+    The arm panels share one scale (every method's motion) and show their ticks; each error
+    curve grows with the frames up to the iteration shown.
     """
     names = list(results)
     longest = max(r.iterations for r in results.values())
@@ -259,19 +261,19 @@ def animate_race(arm, results, target, max_frames=MAX_FRAMES, spacing="log", fig
     axes = [fig.add_subplot(grid[0, k]) for k in range(n)]
     ax_err = fig.add_subplot(grid[1, :])
     artists, trails, headings, paths, dots = [], [], [], [], []
+    every = np.concatenate([r.trace.theta[np.minimum(ks, r.iterations)] for r in results.values()])
     for k, (name, ax) in enumerate(zip(names, axes)):
         res, c = results[name], color_for(name, k)
-        shown = np.minimum(ks, res.iterations)
-        motion_axes(ax, arm, res.trace.theta[shown], targets=[target])
+        motion_axes(ax, arm, every, targets=[target])  # one scale for every panel
         draw_reach(ax, arm)
         draw_target(ax, target, label=None)
         paths.append(end_path(arm, res.trace.theta))
         trails.append(ax.plot([], [], ".-", color=c, lw=0.8, ms=2, alpha=0.6)[0])
         artists.append(draw_arm(ax, arm, res.trace.theta[0], color=c, lw=2.5))
         headings.append(ax.set_title(name, fontsize=9))
-        ax.set_xticks([])
-        ax.set_yticks([])
-    plot_errors(ax_err, results)
+        ax.tick_params(labelsize=9)
+        ax.locator_params(nbins=4)
+    curves = plot_errors(ax_err, results)  # full curves set the axis limits; frames cut them
     for k, name in enumerate(names):
         res = results[name]
         dots.append(ax_err.plot([], [], "o", color=color_for(name, k), ms=5)[0])
@@ -286,16 +288,17 @@ def animate_race(arm, results, target, max_frames=MAX_FRAMES, spacing="log", fig
         k = ks[j]
         drawn = [marker]
         marker.set_xdata([k, k])
-        for name, art, trail, head, path, dot in zip(names, artists, trails, headings, paths, dots):
+        for name, art, trail, head, path, dot, curve in zip(names, artists, trails, headings, paths, dots, curves):
             res = results[name]
             kk = min(k, res.iterations)
+            curve.set_data(np.arange(kk + 1), np.maximum(res.trace.error[: kk + 1], 1e-16))
             set_arm(art, arm, res.trace.theta[kk])
             first = max(0, kk - TRAIL)
             trail.set_data(path[first: kk + 1, 0], path[first: kk + 1, 1])
             dot.set_data([kk], [max(res.trace.error[kk], 1e-16)])
             state = _finish(res) if k >= res.iterations else f"iteration {kk}"
             head.set_text(f"{name}: {state}\n|e| = {res.trace.error[kk]:.3g}")
-            drawn += [*art, trail, head, dot]
+            drawn += [*art, trail, head, dot, curve]
         return drawn
 
     return _animation(fig, frame, ks, interval=300)

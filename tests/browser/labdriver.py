@@ -13,6 +13,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import urllib.error
 import urllib.request
 from contextlib import contextmanager
 from pathlib import Path
@@ -38,16 +39,29 @@ def free_port():
         return s.getsockname()[1]
 
 
-def wait_until(condition, timeout, what, every=0.25):
-    """condition()'s first true value within timeout seconds; an element re-rendered while the
-    condition read it (a widget redrawn) counts as not yet."""
-    from selenium.common.exceptions import StaleElementReferenceException
+REPLY_TIMEOUT = 60  # s: one REST request; a request that outlasts it is asked again (not yet)
+PATIENCE = 1800  # s: how long a wait for JupyterLab or a kernel may last before it counts as a hang
 
+
+def not_yet_errors():
+    """Errors that mean "not yet", never "failed": no answer from the server yet (OSError: refused,
+    reset, timed out on a busy machine) and, with selenium, an element redrawn while read."""
+    try:
+        from selenium.common.exceptions import StaleElementReferenceException
+    except ImportError:  # the REST calls alone need no selenium
+        return (OSError,)
+    return (OSError, StaleElementReferenceException)
+
+
+def wait_until(condition, timeout, what, every=0.25):
+    """condition()'s first true value. It is asked again while it is false or raises one of
+    not_yet_errors(); timeout (s) only guards against a hang, so it is generous."""
+    retry = not_yet_errors()
     end = time.monotonic() + timeout
     while time.monotonic() < end:
         try:
             value = condition()
-        except StaleElementReferenceException:
+        except retry:
             value = None
         if value:
             return value
@@ -86,7 +100,7 @@ def jupyterlab(home, notebooks=()):
                 return server.poll() is not None  # died: stop waiting, fail below
 
         try:
-            wait_until(up, 120, "JupyterLab to start")
+            wait_until(up, PATIENCE, "JupyterLab to start")
             assert server.poll() is None, (home / "lab.log").read_text()[-3000:]
             yield url
         finally:
@@ -116,20 +130,32 @@ def chromium(width=WIDTH, height=HEIGHT):
         shutil.rmtree(profile, ignore_errors=True)
 
 
+def sessions(url):
+    """The server's running sessions (REST API). A slow or refused request raises OSError, which
+    wait_until takes as "not yet"."""
+    with urllib.request.urlopen(f"{url}/api/sessions?token={TOKEN}", timeout=REPLY_TIMEOUT) as reply:
+        return json.load(reply)
+
+
 def kernel_states(url):
-    """Execution state of each running session's kernel, from the server's REST API."""
-    with urllib.request.urlopen(f"{url}/api/sessions?token={TOKEN}", timeout=5) as reply:
-        return [s["kernel"]["execution_state"] for s in json.load(reply)]
+    """Execution state of each running session's kernel; call it inside wait_until."""
+    return [s["kernel"]["execution_state"] for s in sessions(url)]
 
 
 def shut_down_kernels(url):
-    """Shut down every running kernel (one notebook's kernel at a time on 2 cores)."""
-    with urllib.request.urlopen(f"{url}/api/sessions?token={TOKEN}", timeout=5) as reply:
-        sessions = json.load(reply)
-    for s in sessions:
-        request = urllib.request.Request(f"{url}/api/sessions/{s['id']}?token={TOKEN}",
-                                         method="DELETE")
-        urllib.request.urlopen(request, timeout=30).close()
+    """Shut down every running kernel (one notebook's kernel at a time on 2 cores), waiting for
+    the server's answers however busy the machine is."""
+    def delete(session):
+        request = urllib.request.Request(f"{url}/api/sessions/{session}?token={TOKEN}", method="DELETE")
+        try:
+            urllib.request.urlopen(request, timeout=REPLY_TIMEOUT).close()
+        except urllib.error.HTTPError as error:
+            if error.code != 404:  # 404: gone already (an earlier request that timed out did it)
+                raise
+        return True
+
+    for s in wait_until(lambda: (sessions(url),), PATIENCE, "the session list")[0]:
+        wait_until(lambda: delete(s["id"]), PATIENCE, f"session {s['id']} to shut down")
 
 
 def code_cell_count(path):
@@ -141,9 +167,9 @@ def run_all(driver, url, name, code_cells, timeout=600):
     from selenium.webdriver.common.by import By
 
     driver.get(f"{url}/lab/tree/{name}?token={TOKEN}&reset")  # reset: no earlier tab restored
-    wait_until(lambda: driver.find_elements(By.CSS_SELECTOR, ".jp-Notebook .jp-Cell"), 120,
+    wait_until(lambda: driver.find_elements(By.CSS_SELECTOR, ".jp-Notebook .jp-Cell"), PATIENCE,
                "the notebook to open")
-    wait_until(lambda: "idle" in kernel_states(url), 180, "the kernel to start")
+    wait_until(lambda: "idle" in kernel_states(url), PATIENCE, "the kernel to start")
     driver.find_element(By.XPATH, "//li[contains(@class,'lm-MenuBar-item')][.='Run']").click()
     driver.find_element(By.XPATH, "//li[contains(@class,'lm-Menu-item')]"
                                   "[.//*[normalize-space()='Run All Cells']]").click()

@@ -1,8 +1,8 @@
 """The book (make site) as a reader sees it, in headless Chromium from file:// (no server, no
 network): every page at a phone's width (375 px) and a laptop's (1280 px) with its math typeset
 (no raw TeX, no MathJax error), no console error, no serious or critical accessibility violation
-found by axe-core (npm, node_modules/axe-core), no heading larger than one of higher rank and
-nothing wider than the screen; the menu and
+found by axe-core (npm, node_modules/axe-core), no heading larger than one of higher rank,
+nothing wider than the screen and no word in a table wider than its cell; the menu and
 the page's contents open at 375, 768 and 1280 px; search finds pages with no console error from
 disk, and with snippets when served. Screenshots go to $BROWSER_SHOTS (default
 /tmp/ikteach-browser). The decks are tests/browser/site_slides.py.
@@ -95,6 +95,43 @@ return heads.filter(h => heads.some(g => g.tagName < h.tagName && size(g) < size
             .map(h => `${h.tagName} ${size(h)}px ${h.innerText.slice(0, 40)}`);"""
 
 
+# A word in a table cell wider than the cell: broken across lines (overflow-wrap: anywhere let a
+# column shrink to one letter, "s/y/m/b/ol") or running past the cell's edge. Words are runs of
+# letters, digits and underscores, outside typeset math.
+TABLE_WORDS_TOO_WIDE = """
+const found = [];
+for (const cell of document.querySelectorAll('.bd-article td, .bd-article th')) {
+  const box = cell.getBoundingClientRect();
+  const walker = document.createTreeWalker(cell, NodeFilter.SHOW_TEXT);
+  for (let node = walker.nextNode(); node; node = walker.nextNode()) {
+    if (node.parentElement.closest('mjx-container')) continue;
+    for (const word of node.textContent.matchAll(/[\\p{L}\\p{N}_]+/gu)) {
+      const range = document.createRange();
+      range.setStart(node, word.index);
+      range.setEnd(node, word.index + word[0].length);
+      const rects = [...range.getClientRects()].filter(r => r.width > 0);
+      const lines = new Set(rects.map(r => Math.round(r.bottom))).size;
+      const past = rects.some(r => r.right > box.right + 1 || r.left < box.left - 1);
+      if (lines > 1 || past) found.push(`${word[0].slice(0, 24)} (${Math.round(box.width)} px cell)`);
+    }
+  }
+}
+return found;"""
+
+
+# Typeset math in the page's contents column (the headings) shrunk below readable size: a long
+# formula in a heading is scaled to the column's width (lecture 04's identity was 6 px tall).
+TINY_CONTENTS_MATH = """
+return [...document.querySelectorAll('.bd-sidebar-secondary mjx-container svg')]
+  .filter(s => s.getClientRects().length && s.getBoundingClientRect().height < 9)
+  .map(s => `${Math.round(s.getBoundingClientRect().height)} px: ${s.closest('a')?.innerText.slice(0, 30)}`);"""
+
+# More than one search field on screen (the header's and the menu's).
+SEARCH_FIELDS = """
+return [...document.querySelectorAll('.search-button-field')]
+  .filter(e => e.getClientRects().length && !e.closest('dialog:not([open])')).length;"""
+
+
 def overflow(driver):
     """How many CSS pixels the page is wider than the screen (0: it fits)."""
     return driver.execute_script(
@@ -128,7 +165,10 @@ def check_pages(driver, site, pages, width):
                  "console errors": console_errors(driver)[:2],
                  "axe": axe_violations(driver)[:2],
                  "headings larger than a higher rank": driver.execute_script(HEADINGS_OUT_OF_RANK)[:2],
-                 "wider than the screen by (px)": overflow(driver)}
+                 "wider than the screen by (px)": overflow(driver),
+                 "table words wider than their cell": driver.execute_script(TABLE_WORDS_TOO_WIDE)[:3],
+                 "formulas in the contents under 9 px": driver.execute_script(TINY_CONTENTS_MATH)[:2],
+                 "search fields on screen beyond one": max(0, driver.execute_script(SEARCH_FIELDS) - 1)}
         problems += [f"{page} at {width}: {what}: {value}" for what, value in found.items() if value]
         if page in SHOT_PAGES:
             shoot(driver, f"site-{SHOT_PAGES[page]}-{width}.png")
