@@ -179,7 +179,8 @@ def test_lock_walk_finds_vtk_through_the_scenes_extra_only():
     assert not {"vtk", "pyvista", "trame", "jupyterlab"} & lock_closure(())
 
 
-@pytest.mark.parametrize("path", notebook_header.notebook_paths(ROOT), ids=lambda p: p.name)
+@pytest.mark.parametrize("path", notebook_header.notebook_paths(ROOT),
+                         ids=lambda p: p.relative_to(ROOT).as_posix())
 def test_colab_cell_brings_vtk_only_to_lectures_that_draw_in_3d(path):
     package, extras = colab_requirement(path)
     assert package == "ikteach"
