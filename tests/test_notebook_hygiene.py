@@ -27,10 +27,12 @@ def _first_code(nb):
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.relative_to(ROOT).as_posix())
 def test_first_code_cell_is_generated_from_the_course_home(path):
-    source = _first_code(_load(path))
-    assert source.startswith(notebook_header.header(HOME)), \
+    nb = _load(path)
+    source = _first_code(nb)
+    extras = notebook_header.extras(nb)
+    assert source.startswith(notebook_header.header(HOME, extras)), \
         f"{path.name}: first cell out of date, run `make header`"
-    assert HOME.requirement in source
+    assert HOME.requirement_with(extras) in source
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.relative_to(ROOT).as_posix())
@@ -87,7 +89,8 @@ def test_header_follows_a_new_home(tmp_path):
     for path in notebook_header.notebook_paths(root):
         source = _first_code(_load(path))
         assert source.count("%pip install") == 1
-        assert '"ikteach @ git+https://github.com/a-school/ik-course@main"' in source
+        assert re.search(r'"ikteach(\[scenes\])? @ git\+https://github\.com/a-school/ik-course@main"',
+                         source)
     assert "github.com/ikteach-course" not in (root / "README.md").read_text()
     assert home.binder_url("notebooks/01_jacobian.ipynb") in (root / "notebooks" / "README.md").read_text()
 

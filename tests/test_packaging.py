@@ -1,17 +1,24 @@
 """pyproject.toml, the lock, Binder and conda agree; runtime dependencies are only what the
-module needs; the course's home is named once."""
+module needs; each notebook's Colab cell installs what that notebook uses; the course's home is
+named once."""
+import json
 import re
 from pathlib import Path
+
+import pytest
 
 try:
     import tomllib
 except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib
 
-from ikteach.course import course_home
+from ikteach.course import course_home, notebook_header
+from test_wheel import COLAB  # Colab's preinstalled versions
 
 ROOT = Path(__file__).resolve().parents[1]
-RUNTIME = {"jax", "jaxlib", "numpy", "matplotlib", "pyvista", "scikit-image", "ipywidgets"}
+RUNTIME = {"jax", "jaxlib", "numpy", "matplotlib", "scikit-image", "ipywidgets"}
+# The lectures that draw in 3-D (ik.pictures.scene): the only ones whose cell brings VTK.
+DRAW_3D = {"06_pose_targets_3d.ipynb", "07_workspace_maps.ipynb", "09_characters.ipynb"}
 
 
 def _name(requirement):
@@ -51,18 +58,21 @@ def test_runtime_dependencies_are_what_the_module_needs():
 
 def test_extras_hold_the_lab_the_grader_and_the_tools():
     extras = {k: {_name(r) for r in v} for k, v in pyproject()["project"]["optional-dependencies"].items()}
-    assert {"lab", "grade", "3d", "dev", "bench"} <= set(extras)
+    assert {"lab", "grade", "scenes", "3d", "dev", "bench"} <= set(extras)
     assert "jupyterlab" in extras["lab"]
     assert {"nbformat", "nbclient", "ipykernel"} <= extras["grade"]
+    assert extras["scenes"] == {"pyvista"}
     assert "pyvista" in extras["3d"]  # pyvista[jupyter]: trame and friends
     assert {"pytest", "pytest-xdist", "nbval", "hypothesis", "ikteach"} <= extras["dev"]
-    assert not (extras["lab"] | extras["grade"] | extras["3d"]) & RUNTIME - {"pyvista"}
+    assert "scenes" in next(r for r in pyproject()["project"]["optional-dependencies"]["dev"]
+                            if _name(r) == "ikteach")  # the tests render scenes
+    assert not (extras["lab"] | extras["grade"] | extras["3d"]) & RUNTIME
 
 
 def test_lock_pins_every_runtime_dependency():
     versions = locked_versions()
     assert RUNTIME <= set(versions)
-    assert "jupyterlab" in versions and "trame" in versions
+    assert "jupyterlab" in versions and "trame" in versions and "vtk" in versions
 
 
 def test_binder_installs_the_package_with_lab_and_3d_extras_from_the_lock():
@@ -71,7 +81,7 @@ def test_binder_installs_the_package_with_lab_and_3d_extras_from_the_lock():
     assert requirements == ["-c constraints.txt", ".[lab,3d]"]
     # The same runtime dependencies as pyproject (they come from it), at the locked versions.
     pins, locked = binder_pins(), locked_versions()
-    for name in pyproject_runtime() | {"jupyterlab", "trame"}:
+    for name in pyproject_runtime() | {"jupyterlab", "trame", "pyvista"}:
         assert name in pins, f"binder/constraints.txt does not pin {name}: run make lock"
         assert pins[name] == locked[name], f"binder/constraints.txt is older than uv.lock ({name})"
     assert "ikteach" not in pins
@@ -120,3 +130,78 @@ def test_importing_ikteach_enables_float64():
     import ikteach  # noqa: F401
 
     assert jnp.zeros(1).dtype == jnp.float64
+
+
+def _floor(name):
+    """The lower bound pyproject.toml puts on a runtime dependency, as a version tuple."""
+    requirement = next(r for r in pyproject()["project"]["dependencies"] if _name(r) == name)
+    m = re.search(r">=\s*([\d.]+)", requirement)
+    assert m, f"pyproject.toml: {name} has no lower bound"
+    return tuple(int(v) for v in m.group(1).split("."))
+
+
+def _version(text):
+    return tuple(int(v) for v in re.match(r"[\d.]*\d", text).group(0).split("."))
+
+
+def lock_closure(extras):
+    """Every package uv.lock can install for ikteach with these extras (markers ignored: every
+    Python and platform, so a package missing here is missing everywhere)."""
+    packages = {}
+    for package in tomllib.loads((ROOT / "uv.lock").read_text())["package"]:
+        packages.setdefault(package["name"], []).append(package)
+    seen, todo = set(), [("ikteach", tuple(extras))]
+    while todo:
+        name, wanted = todo.pop()
+        if (name, wanted) in seen:
+            continue
+        seen.add((name, wanted))
+        for package in packages[name]:
+            deps = list(package.get("dependencies", []))
+            for extra in wanted:
+                deps += package.get("optional-dependencies", {}).get(extra, [])
+            todo += [(dep["name"], tuple(dep.get("extra", ()))) for dep in deps]
+    return {name for name, _ in seen}
+
+
+def colab_requirement(path):
+    """The requirement a notebook's first cell pip-installs on Colab: (package, extras)."""
+    nb = json.loads(Path(path).read_text(encoding="utf-8"))
+    first = next("".join(c["source"]) for c in nb["cells"] if c["cell_type"] == "code")
+    m = re.search(r'%pip install --quiet "([\w-]+)(?:\[([\w,-]+)\])? @ ', first)
+    assert m, f"{path.name}: no generated Colab cell"
+    return m.group(1), tuple(m.group(2).split(",")) if m.group(2) else ()
+
+
+def test_lock_walk_finds_vtk_through_the_scenes_extra_only():
+    assert "vtk" in lock_closure(("scenes",)) and "trame" in lock_closure(("3d",))
+    assert {"jax", "jaxlib", "numpy", "scipy"} <= lock_closure(())
+    assert not {"vtk", "pyvista", "trame", "jupyterlab"} & lock_closure(())
+
+
+@pytest.mark.parametrize("path", notebook_header.notebook_paths(ROOT),
+                         ids=lambda p: p.relative_to(ROOT).as_posix())
+def test_colab_cell_brings_vtk_only_to_lectures_that_draw_in_3d(path):
+    package, extras = colab_requirement(path)
+    assert package == "ikteach"
+    pulls_vtk = "vtk" in lock_closure(extras)
+    draws_3d = path.parent.name == "notebooks" and path.name in DRAW_3D
+    assert pulls_vtk == draws_3d, f"{path.name}: extras {extras}"
+
+
+def test_jax_floor_agrees_in_pyproject_colab_and_binder():
+    floor = _floor("jax")
+    assert _floor("jaxlib") == floor
+    # Colab: the cell names the package alone (no jax pin of its own), so its floor is
+    # pyproject's; that floor must not exceed Colab's jax, so that pip keeps Colab's jax, jaxlib
+    # and CUDA plugin together (the plugin's metadata does not pin jaxlib: an upgrade of jax
+    # alone would leave a mismatched plugin behind).
+    for path in notebook_header.notebook_paths(ROOT):
+        nb = json.loads(path.read_text(encoding="utf-8"))
+        first = next("".join(c["source"]) for c in nb["cells"] if c["cell_type"] == "code")
+        assert "jax" not in first.split("%pip install", 1)[1].split("\n", 1)[0], path.name
+    assert floor <= _version(COLAB["jax"]) and floor <= _version(COLAB["jaxlib"])
+    # Binder (binder/requirements.txt and, through it, environment.yml) installs the lock's jax.
+    pins = binder_pins()
+    assert pins["jax"] == pins["jaxlib"]
+    assert all(_version(v) >= floor for v in pins["jax"])

@@ -1,8 +1,8 @@
 """The built package works outside the checkout: wheel and sdist from a copy of the source
 (plus a probe data file, to show that new package data is shipped), the wheel installed into
 a clean venv in a temporary folder, then a solve, a plot and an off-screen pyvista scene run
-from there. A second venv stands in for Colab: Colab's preinstalled jax, numpy, matplotlib
-and ipywidgets first, then the wheel, which upgrades those below pyproject's bounds only.
+from there. A second venv stands in for Colab: Colab's preinstalled jax, numpy, matplotlib,
+ipywidgets... first, then the wheel, which upgrades those below pyproject's bounds only (ipywidgets).
 
 uv does the builds and installs (from its cache after the first run; pins from the lock).
 """
@@ -20,18 +20,15 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 PROBE = "data/_probe_for_tests.txt"
 
-# Colab's preinstalled versions (Python 3.12): numpy 2.0.2 and matplotlib 3.10.0 from a
-# listing of Colab's runtime (2026-02); jax 0.5.2 from Colab's announced upgrade
-# (googlecolab/colabtools#5164, with jaxlib 0.5.1); ipywidgets 7.7.1 from Colab's pip freeze
-# (googlecolab/backend-info). Update them when Colab moves.
+# Colab's preinstalled versions (Python 3.12), from Colab's pip freeze (googlecolab/backend-info,
+# pip-freeze.gpu.txt, 2026; its GPU runtime also has jax-cuda12-plugin and jax-cuda12-pjrt 0.7.2).
+# Update them when Colab moves (docs/lecturers.md, "Colab").
 COLAB_PYTHON = "3.12"
-COLAB = {"jax": "0.5.2", "jaxlib": "0.5.1", "numpy": "2.0.2", "matplotlib": "3.10.0",
-         "ipywidgets": "7.7.1"}
-# Colab's jax, jaxlib and ipywidgets are below pyproject's lower bounds (jax 0.10.2: other
-# printed numbers; ipywidgets 8: the demo's static still), so the wheel upgrades them;
-# matplotlib stays, and numpy too unless the newest jax for that Python needs a newer one
-# (jax 0.12, Python >= 3.12: numpy >= 2.2).
-COLAB_UPGRADED = ("jax", "jaxlib", "ipywidgets")
+COLAB = {"jax": "0.7.2", "jaxlib": "0.7.2", "numpy": "2.0.2", "scipy": "1.16.3",
+         "matplotlib": "3.10.0", "scikit-image": "0.25.2", "ipywidgets": "7.7.1"}
+# Only ipywidgets is below pyproject's lower bounds (ipywidgets 8: the demo's static still), so
+# the wheel upgrades it and keeps the rest: jax, jaxlib (and so the CUDA plugin) stay matched.
+COLAB_UPGRADED = ("ipywidgets",)
 
 SMOKE = r'''
 import importlib.resources, sys
@@ -140,13 +137,13 @@ def test_wheel_and_sdist_ship_the_module_and_package_data(dist):
     requires = [line for line in metadata.splitlines() if line.startswith("Requires-Dist:")]
     runtime = [r for r in requires if "extra ==" not in r]
     assert {re.split(r"[<>=!\[ ]", r.split()[1])[0] for r in runtime} == {
-        "jax", "jaxlib", "numpy", "matplotlib", "pyvista", "scikit-image", "ipywidgets"}
+        "jax", "jaxlib", "numpy", "matplotlib", "scikit-image", "ipywidgets"}
 
 
 def test_wheel_in_a_clean_venv_solves_plots_and_renders(dist, tmp_path):
     wheel, _ = dist
     python = _venv(tmp_path, sys.executable)
-    _uv("pip", "install", "--quiet", "--python", str(python), str(wheel),
+    _uv("pip", "install", "--quiet", "--python", str(python), f"ikteach[scenes] @ {wheel.as_uri()}",
         "-c", str(ROOT / "binder" / "constraints.txt"))
     work = tmp_path / "work"
     work.mkdir()
@@ -180,11 +177,12 @@ def test_wheel_on_a_colab_like_kernel_keeps_colabs_numpy_and_matplotlib(dist, tm
     _uv("pip", "install", "--quiet", "--python", str(python), str(wheel))  # what Colab's cell does
     listed = dict(line.split()[:2] for line in
                   _uv("pip", "list", "--python", str(python)).stdout.splitlines()[2:])
-    for name in COLAB_UPGRADED:
-        assert listed[name] != COLAB[name], f"Colab's {name} {COLAB[name]} was kept"
-    assert listed["matplotlib"] == COLAB["matplotlib"], "installing the wheel changed matplotlib"
-    jax_version = tuple(int(v) for v in listed["jax"].split(".")[:2])
-    assert listed["numpy"] == COLAB["numpy"] or jax_version >= (0, 12), listed["numpy"]
+    for name, version in COLAB.items():
+        if name in COLAB_UPGRADED:
+            assert listed[name] != version, f"Colab's {name} {version} was kept"
+        else:
+            assert listed[name] == version, f"installing the wheel changed Colab's {name}"
+    assert not {"pyvista", "vtk"} & set(listed), "the lectures without 3-D pulled VTK"
     work = tmp_path / "work"
     work.mkdir()
     (work / "smoke.py").write_text(SMOKE)

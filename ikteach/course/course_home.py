@@ -37,7 +37,12 @@ class Home:
     @property
     def requirement(self):
         """What Colab's first cell pip-installs: the package from the repository's branch."""
-        return f"{self.package} @ git+{self.repository}@{self.branch}"
+        return self.requirement_with()
+
+    def requirement_with(self, extras=()):
+        """The requirement with the package's extras, e.g. ikteach[scenes] @ git+..."""
+        name = f"{self.package}[{','.join(extras)}]" if extras else self.package
+        return f"{name} @ git+{self.repository}@{self.branch}"
 
     def colab_url(self, path):
         return f"https://colab.research.google.com/github/{self.github}/blob/{self.branch}/{path}"

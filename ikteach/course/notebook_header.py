@@ -9,8 +9,9 @@ installs the course from that ref and every badge opens the notebooks as they ar
 (docs/lecturers.md, "A term's release"). `--ref main` goes back.
 
 The first code cell of each notebook (lecture notebooks, exercises, instructor solutions)
-starts with a generated block: on Colab only, pip-install the course package quietly (its
-dependencies bring what Colab lacks, e.g. pyvista). The rest of the cell (the notebook's own
+starts with a generated block: on Colab only, pip-install the course package quietly. Its
+dependencies bring only what Colab lacks (Colab's jax, numpy, matplotlib... are new enough and
+stay); a notebook that draws in 3-D asks for the `scenes` extra (pyvista, VTK) too. The rest of the cell (the notebook's own
 imports and `ik.notebook.setup()`) is kept. A notebook whose first code cell has no block
 gets one in front. The first Markdown cell ends with a link to the course's one notation table
 (notebooks/README.md#notation). The badges go into README.md (a generated table between markers) and
@@ -35,18 +36,29 @@ README_END = "<!-- end of notebook badges -->"
 ROW = re.compile(r"^\|\s*`(\d\d_[\w-]+\.ipynb)`[^|]*\|", re.M)
 
 
-def header(h):
+# A notebook draws in 3-D where its code calls ik.pictures.scene (scene.show, scene.scene...)
+# or imports pyvista: only those ask for pyvista and VTK (about 100 MB on Colab).
+DRAWS_3D = re.compile(r"\bscene\.\w+\(|^\s*(?:import|from)\s+pyvista\b", re.M)
+
+
+def extras(nb):
+    """The package extras a notebook's cells need: ("scenes",) where it draws in 3-D."""
+    code = "\n".join(_text(c) for c in nb["cells"] if c["cell_type"] == "code")
+    return ("scenes",) if DRAWS_3D.search(code) else ()
+
+
+def header(h, extras=()):
     """The generated block (ends with a newline)."""
     return (f"{MARKER}\n"
             "import sys\n"
             'if "google.colab" in sys.modules:  # on Colab only: install the course package\n'
-            f'    %pip install --quiet "{h.requirement}"\n')
+            f'    %pip install --quiet "{h.requirement_with(extras)}"\n')
 
 
-def with_header(source, h):
+def with_header(source, h, extras=()):
     """A first code cell's source with its generated block replaced (or put in front)."""
     rest = BLOCK.sub("", source, count=1)
-    return header(h) + rest
+    return header(h, extras) + rest
 
 
 NOTATION = "Symbols: the course's one [notation table]({link}), one meaning each."
@@ -72,9 +84,13 @@ def notebook_paths(root=ROOT):
             + sorted((root / "instructor" / "solutions").glob("*.ipynb")))
 
 
+def _text(cell):
+    return "".join(cell["source"]) if isinstance(cell["source"], list) else cell["source"]
+
+
 def _edit(cell, edit):
     """Apply edit to a cell's source; True when that changed it."""
-    source = "".join(cell["source"]) if isinstance(cell["source"], list) else cell["source"]
+    source = _text(cell)
     new = edit(source)
     if new == source:
         return False
@@ -90,7 +106,8 @@ def update_notebook(path, h, write=True, root=ROOT):
     if not code:
         raise ValueError(f"{path}: expected at least one code cell")
     markdown = [c for c in nb["cells"] if c["cell_type"] == "markdown"]
-    changed = _edit(code[0], lambda src: with_header(src, h))
+    needs = extras(nb)
+    changed = _edit(code[0], lambda src: with_header(src, h, needs))
     if markdown:
         link = notation_link(path, root)
         changed = _edit(markdown[0], lambda src: with_notation(src, link)) or changed

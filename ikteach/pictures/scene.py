@@ -20,7 +20,10 @@ STATIC_BACKENDS = (None, "static", "none")  # pv.global_theme.jupyter_backend va
 
 
 def _pv():
-    import pyvista as pv
+    try:
+        import pyvista as pv
+    except ModuleNotFoundError as exc:  # the `scenes` extra: only the 3-D lectures install it
+        raise ModuleNotFoundError("3-D scenes need pyvista: pip install 'ikteach[scenes]'") from exc
 
     from .backend_3d import apply_pyvista_choice
 
