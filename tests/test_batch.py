@@ -119,10 +119,27 @@ def test_a_queued_batch_gives_what_solve_gives_on_every_task_kind(kind):
         rows = ik.solve_batch(arm, targets, start, method=method, max_iter=300, **kw)
         for k in range(len(targets)):
             one = ik.solve(arm, targets[k], start, method=method, max_iter=300, **kw)
-            assert (one.status, one.iterations) == (rows.status[k], rows.iterations[k]), (method, k)
+            assert one.status == rows.status[k], (method, k)
+            if _jaxlib_version() < SAME_BITS_FROM and _chaotic(one):
+                continue  # older XLA rounds the vectorised arithmetic otherwise, and chaos grows it
+            assert one.iterations == rows.iterations[k], (method, k)
             if (method, one.status) == ("jt", "max_iter"):
                 continue  # chaotic: see the next test (measured here: 2e-2 rad on a pose row)
+            if _jaxlib_version() < SAME_BITS_FROM:
+                np.testing.assert_allclose(one.theta, rows.theta[k], rtol=0, atol=1e-9)
+                continue
             _equal_bits(one.theta, rows.theta[k], err_msg=f"{method} row {k}")
+
+
+# From this jaxlib on a queued row takes ik.solve's steps to the last bits; with older ones (the
+# floor, 0.7.2: docs/maintainers.md, "Supported jax") the last bits differ, and a chaotic run
+# (one that never settles, or wanders through many turns before it does) can end elsewhere.
+SAME_BITS_FROM = (0, 10)
+
+
+def _chaotic(result):
+    """A run that never settled (max_iter) or wandered beyond ten turns of a joint."""
+    return result.status == "max_iter" or np.abs(result.theta).max() > 20 * np.pi
 
 
 def test_a_chaotic_run_may_drift_beyond_the_last_bits_but_not_in_status():
