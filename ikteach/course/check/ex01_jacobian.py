@@ -7,8 +7,8 @@ import numpy as np
 
 from ...core.chain import planar_chain
 from ...core.jacobian import jacobian as _ref_jacobian
-from .verdicts import (_Case, _Fail, _Part, _as_array, _call, _close, _evaluate, _fmt,
-                       _guarded, _mismatch, _rng, _shape_message)
+from .verdicts import (_as_array, _call, _Case, _close, _evaluate, _Fail, _fmt, _guarded,
+                       _in_every_draw, _mismatch, _Part, _rng, _shape_message)
 
 NUMBER = 1
 CHECK_NAME = "jacobian"
@@ -45,6 +45,7 @@ def _hidden_hand(rng):
             (lengths(3), [angle(), 0.0, 0.0], "singular")]
 
 
+@_in_every_draw
 def _jacobian_cases(seed=None):
     rng = _rng(seed, 0)
     cases = list(HAND if seed is None else _hidden_hand(rng))
@@ -104,14 +105,14 @@ def _jacobian_parts(fn, name, seed=None):
     def compared(tag):
         """(case, got, want) of the cases with `tag`, shapes checked first."""
         for case in (c for c in cases if c.tag == tag):
-            got, want = result(case), _jacobian_reference(*case.args)
+            got, want = result(case), case.want(_jacobian_reference)
             if got.shape != want.shape:
                 raise _Fail(_shape_message(name, got, want, case))
             yield case, got, want
 
     def shape():
         for case in cases:
-            got, want = result(case), _jacobian_reference(*case.args)
+            got, want = result(case), case.want(_jacobian_reference)
             if got.shape != want.shape:
                 hint = (" - one row per coordinate (x, y), one column per joint: transposed?"
                         if got.shape == want.T.shape else " - (2, number of joints)")

@@ -6,8 +6,8 @@ J J^T e = 0 2.
 import numpy as np
 
 from ...core.jt import jt_step as _ref_jt
-from .verdicts import (_Case, _Fail, _Part, _as_array, _call, _close, _evaluate, _guarded,
-                       _matrix_text, _mismatch, _rng, _shape_message)
+from .verdicts import (_as_array, _call, _Case, _close, _evaluate, _Fail, _guarded, _in_every_draw,
+                       _matrix_text, _mismatch, _Part, _rng, _shape_message)
 
 NUMBER = 2
 CHECK_NAME = "jt_step"
@@ -46,6 +46,7 @@ def _hidden_hand(rng):
             (np.zeros((2, n + 1)), rng.normal(size=2).round(3), "zero")]  # not square
 
 
+@_in_every_draw
 def _jt_cases(seed=None):
     rng = _rng(seed, 2)
     hand = []
@@ -76,7 +77,7 @@ def _jt_parts(fn, name, seed=None):
         return c, _close(got, c * g)
 
     def _ref(case):
-        return np.asarray(_ref_jt(*case.args))
+        return case.want(_ref_jt)
 
     regular = [c for c in cases if c.tag == "regular"]
 

@@ -7,9 +7,9 @@ guard for sigma_max = 0 (J = 0: nothing is kept) 2.
 import numpy as np
 
 from ...core.pinv import pinv_step as _ref_pinv
-from .verdicts import (_Case, _Fail, _Part, _as_array, _call, _close, _evaluate, _fmt, _guarded,
-                       _matrix_text, _mismatch, _rng, _shape_message, _random_matrix,
-                       _with_singular_values)
+from .verdicts import (_as_array, _call, _Case, _close, _evaluate, _Fail, _fmt, _guarded,
+                       _in_every_draw, _matrix_text, _mismatch, _Part, _random_matrix, _rng,
+                       _shape_message, _with_singular_values)
 
 NUMBER = 3
 CHECK_NAME = "pinv_step"
@@ -31,7 +31,9 @@ def _singular_hand(rng):
         (np.array([[1.0, 1.0], [1.0, 1.0]]), np.array([1.0, -1.0]), 1e-6),
         (_with_singular_values(rng, [1.0, 1e-9], 2, 3).round(12), np.array([0.3, 0.4]), 1e-6),
         (_with_singular_values(rng, [100.0, 1e-5], 2, 2), np.array([1.0, 1.0]), 1e-6),
-        (_with_singular_values(rng, [1e-3, 1e-8], 2, 3), np.array([0.2, -0.1]), 1e-4),
+        # a small J (sigma_max below every hidden case's): the cut-off is relative, the step
+        # is not zero (nor is it for a guard at a fixed size of sigma_max)
+        (_with_singular_values(rng, [5e-5, 5e-10], 2, 3), np.array([0.2, -0.1]), 1e-4),
         # sigma_min / sigma_max between 1e-5 and 0.1: rcond decides, on either side
         (_with_singular_values(rng, [1.0, 1e-3], 2, 3), np.array([0.5, -0.2]), 1e-6),
         (_with_singular_values(rng, [2.0, 0.06], 2, 2), np.array([0.3, 0.7]), 0.05),
@@ -62,6 +64,7 @@ def _singular_hidden(rng):
     return out
 
 
+@_in_every_draw
 def _pinv_cases(seed=None):
     rng = _rng(seed, 3)
     cases = []
@@ -128,7 +131,12 @@ def _diagnose(got, want, case):
     if swapped is not None and (_close(got, swapped) or _close(got, -swapped)):
         return ("U and V swapped: delta_theta = V Sigma^+ U^T e (np.linalg.svd returns U, "
                 "sigma and V^T)." + _mismatch(got, want, case))
-    if _close(got, _pinv_variant(J, e, lambda s: s > 0), rtol=1e-4):
+    if not np.any(got) and np.linalg.norm(J, 2) < 1e-2:
+        return ("your step is zero for a small J: the cut-off is relative, so J's largest "
+                "singular values are kept however small (a guard at a fixed sigma_max?)."
+                + _mismatch(got, want, case))
+    uncut = _pinv_variant(J, e, lambda s: s > 0)
+    if _close(got, uncut, rtol=1e-4) and not _close(uncut, want, rtol=1e-4):
         return ("no cut-off: 1/sigma_i must be dropped for sigma_i < rcond * "
                 f"sigma_max; here your step is {np.linalg.norm(got):.3g} long (np.linalg.pinv(J) "
                 "keeps every sigma_i >= 1e-15 sigma_max)." + _mismatch(got, want, case))
@@ -161,7 +169,7 @@ def _pinv_parts(fn, name, seed=None):
         counts; otherwise -J^+ e passes too)."""
         for case in (c for c in cases if c.tag == tag):
             J, e, rcond = case.args
-            got, want = result(case), np.asarray(_ref_pinv(J, e, rcond))
+            got, want = result(case), case.want(_ref_pinv)
             if got.shape != want.shape:
                 hint = (" - one entry per joint: delta_theta = V Sigma^+ U^T e"
                         if got.shape == e.shape else "")

@@ -6,8 +6,8 @@ form is defined for a wide J, the n x n form for a tall one, where the other is 
 import numpy as np
 
 from ...core.dls import dls_step as _ref_dls
-from .verdicts import (_Case, _Fail, _Part, _as_array, _call, _check_callable, _close,
-                       _evaluate, _fmt, _matrix_text, _mismatch, _random_matrix, _rng,
+from .verdicts import (_as_array, _call, _Case, _check_callable, _close, _evaluate, _Fail, _fmt,
+                       _in_every_draw, _matrix_text, _mismatch, _Part, _random_matrix, _rng,
                        _shape_message)
 
 NUMBER = 4
@@ -37,6 +37,7 @@ def _hidden_hand(rng):
             (c * np.eye(2), rng.normal(size=2).round(3), lams[2], "")]
 
 
+@_in_every_draw
 def _dls_cases(seed=None):
     rng = _rng(seed, 4)
     cases = []
@@ -55,6 +56,7 @@ def _dls_cases(seed=None):
     return sorted(cases, key=lambda c: c.size)
 
 
+@_in_every_draw
 def _form_cases(seed=None):
     """Damping 0, where only one form is defined: a wide J of full row rank (J J^T invertible,
     the n x n J^T J singular) for the m x m form, a tall J of full column rank for the n x n
@@ -125,7 +127,7 @@ def _dls_parts(fns, names, seed=None):
                         raise
                     first = first or (case, None, str(exc))
                     continue
-                want = np.asarray(_ref_dls(*case.args))
+                want = case.want(_ref_dls)
                 if got.shape != want.shape:
                     return _shape_message(name, got, want, case, " - one entry per joint")
                 if not _close(got, want):
@@ -135,11 +137,11 @@ def _dls_parts(fns, names, seed=None):
             if undamped(which):
                 case, got, error = first
                 return NO_DAMPING + (f"\n  smallest failing case: {case}\n  {error}" if error
-                                     else _mismatch(got, np.asarray(_ref_dls(*case.args)), case))
+                                     else _mismatch(got, case.want(_ref_dls), case))
             case, got, error = first
             if error is not None:
                 raise _Fail(error)
-            return diagnose(which, got, np.asarray(_ref_dls(*case.args)), case)
+            return diagnose(which, got, case.want(_ref_dls), case)
         return check
 
     def both_forms():
@@ -153,8 +155,8 @@ def _dls_parts(fns, names, seed=None):
                         "same step, (J^T J + lambda^2 I)^-1 J^T = J^T (J J^T + lambda^2 I)^-1."
                         f"\n  smallest failing case: {case}\n  {names[0]}: {_fmt(a)}"
                         f"\n  {names[1]}: {_fmt(b)}")
-        for which, case in enumerate(_form_cases(seed)):
-            J, e, _ = case.args
+        for k, case in enumerate(_form_cases(seed)):
+            which, (J, e, _) = k % 2, case.args  # wide, tall, wide, tall
             want, other = np.linalg.pinv(J) @ e, ("J^T J", "J J^T")[which]
             try:
                 got = _as_array(_call(fns[which], names[which], case, J.copy(), e.copy(), 0.0),

@@ -7,6 +7,7 @@ to _evaluate(number, title, function_names, parts).
 """
 import contextlib
 import dataclasses
+import functools
 import os
 import signal
 import sys
@@ -98,25 +99,41 @@ def _call(fn, name, case, *args, limit=None):
 
 
 def _as_array(value, name, case):
-    """The student's return value as a float array, or a _Fail saying what came back."""
+    """The student's return value as a float64 array, or a _Fail saying what came back. The
+    dtype policy (the same in the check cell and the grader): float64 answers only, since the
+    checks compare to 1e-6 of a case's scale and float32 rounding (1e-7, more after an SVD
+    near a singularity) would make a mark depend on the case drawn."""
     if value is None:
         raise _Fail(f"`{name}` returned None on {case} - did you forget `return`?")
     try:
-        arr = np.array(value, dtype=np.float64)
+        raw = np.asarray(value)
+        arr = np.array(raw, dtype=np.float64)
     except (TypeError, ValueError):
         raise _Fail(f"`{name}` returned {type(value).__name__} {value!r:.60} on {case}; "
                     f"expected an array of numbers") from None
+    if raw.dtype.kind == "f" and raw.dtype.itemsize < 8:
+        raise _Fail(f"`{name}` returns {raw.dtype}; return float64 (the checks work to 1e-6 "
+                    f"of the answer's size, which {raw.dtype} rounding does not always meet) "
+                    f"on {case}")
     return arr
 
 
 # --- cases and comparisons -------------------------------------------------------------------
 
-def _fmt(x):
+def _fmt(x, digits=4):
     arr = np.asarray(x, dtype=float)
     if arr.ndim == 0:
-        return f"{float(arr):.4g}"
-    with np.printoptions(precision=4, suppress=True, floatmode="maxprec", linewidth=200):
+        return f"{float(arr):.{digits}g}"
+    small = 0 < np.abs(arr).max(initial=0.0) < 1e-3  # a small J in e-notation, not as zeros
+    with np.printoptions(precision=digits, suppress=not small, floatmode="maxprec",
+                         linewidth=200):
         return np.array2string(arr, separator=", ").replace("\n", "")
+
+
+def _shown(got, want):
+    """got and want printed with as many digits as it takes to tell them apart (4 at least)."""
+    digits = next((d for d in range(4, 17) if _fmt(got, d) != _fmt(want, d)), 17)
+    return _fmt(got, digits), _fmt(want, digits)
 
 
 @dataclasses.dataclass
@@ -125,9 +142,16 @@ class _Case:
     text: str       # how the case is shown to the student
     size: int = 0   # smaller cases are reported first
     tag: str = ""   # which part of the check uses it
+    memo: dict = dataclasses.field(default_factory=dict, repr=False)
 
     def __str__(self):
         return self.text
+
+    def want(self, reference):
+        """reference(*args) as a float array, computed once (a draw's cases are kept)."""
+        if "want" not in self.memo:
+            self.memo["want"] = np.asarray(reference(*self.args), dtype=float)
+        return self.memo["want"]
 
 
 def _close(a, b, rtol=1e-6, atol=1e-9, scale=None):
@@ -141,15 +165,26 @@ def _close(a, b, rtol=1e-6, atol=1e-9, scale=None):
 
 
 def _mismatch(got, want, case, what="the step"):
-    label = f"expected {what}:"
-    width = max(len(label), len("your result:"))
-    return (f"\n  smallest failing case: {case}\n  {label:<{width}} {_fmt(want)}"
-            f"\n  {'your result:':<{width}} {_fmt(got)}")
+    label, yours = f"expected {what}:", "your result:" if what == "the step" else f"your {what}:"
+    width = max(len(label), len(yours))
+    got, want = _shown(got, want)
+    return (f"\n  smallest failing case: {case}\n  {label:<{width}} {want}"
+            f"\n  {yours:<{width}} {got}")
 
 
 def _shape_message(name, got, want, case, hint=""):
     return (f"wrong shape: `{name}` returned shape {got.shape}, expected {want.shape}"
             f"{hint}.\n  smallest failing case: {case}")
+
+
+def _in_every_draw(cases):
+    """cases(seed) -> the check cell's cases (seed None) in every draw, the seed's own on top:
+    the hidden seed only adds cases, so what decides a part is decided alike everywhere."""
+    @functools.lru_cache(maxsize=8)  # one draw serves a whole class
+    def drawn(seed=None):
+        own = tuple(cases(seed))
+        return tuple(sorted(own if seed is None else drawn(None) + own, key=lambda c: c.size))
+    return functools.wraps(cases)(drawn)
 
 
 def _rng(seed, offset):
