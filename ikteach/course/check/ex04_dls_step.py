@@ -6,9 +6,9 @@ form is defined for a wide J, the n x n form for a tall one, where the other is 
 import numpy as np
 
 from ...core.dls import dls_step as _ref_dls
-from .verdicts import (_as_array, _call, _Case, _check_callable, _close, _evaluate, _Fail, _fmt,
-                       _in_every_draw, _matrix_text, _mismatch, _Part, _random_matrix, _rng,
-                       _shape_message)
+from .verdicts import (_as_array, _call, _Case, _close, _evaluate, _Fail, _fmt, _in_every_draw,
+                       _matrix_text, _mismatch, _Part, _random_matrix, _rng, _shape_message,
+                       _turned)
 
 NUMBER = 4
 CHECK_NAME = "dls_step"
@@ -28,13 +28,8 @@ HAND = [(np.array([[0.0, 0.0], [3.0, 2.0]]), np.array([1.0, 0.5]), 0.5, "singula
 
 
 def _hidden_hand(rng):
-    """HAND's kinds with other numbers: a straight arm's J, J = 0, a scaled identity."""
-    a, b, c = rng.uniform(0.5, 3.0, 3).round(3)
-    lams = rng.uniform(0.1, 0.9, 3).round(3)
-    return [(np.array([[0.0, 0.0], [a, b]]), rng.normal(size=2).round(3), lams[0], "singular J"),
-            (np.zeros((2, int(rng.integers(3, 5)))), rng.normal(size=2).round(3), lams[1],
-             "zero J"),
-            (c * np.eye(2), rng.normal(size=2).round(3), lams[2], "")]
+    """HAND turned (verdicts._turned), the same damping."""
+    return [(*(x[0] for x in _turned(rng, [J], [e])), lam, note) for J, e, lam, note in HAND]
 
 
 @_in_every_draw
@@ -117,7 +112,6 @@ def _dls_parts(fns, names, seed=None):
         name = names[which]
 
         def check():
-            _check_callable(fns[which], name)
             first = None  # (case, got or None, error or None): the smallest failing case
             for case in cases:
                 try:
@@ -146,8 +140,6 @@ def _dls_parts(fns, names, seed=None):
 
     def both_forms():
         """The two agree, and each is its own form: at damping 0 only that form is defined."""
-        for which in (0, 1):
-            _check_callable(fns[which], names[which])
         for case in cases:
             a, b = result(0, case), result(1, case)
             if a.shape != b.shape or not _close(a, b):

@@ -7,8 +7,8 @@ no damping (lambda = 0, J1 singular or not: the exact pseudoinverses, finite) 2.
 import numpy as np
 
 from ...core.priority import priority_step as _ref_step
-from .verdicts import (_as_array, _call, _Case, _check_callable, _close, _evaluate, _Fail, _fmt,
-                       _in_every_draw, _mismatch, _Part, _rng, _shape_message)
+from .verdicts import (_as_array, _call, _Case, _close, _evaluate, _Fail, _fmt, _in_every_draw,
+                       _mismatch, _Part, _rng, _shape_message, _turned)
 
 NUMBER = 7
 CHECK_NAME = "priority_step"
@@ -132,34 +132,11 @@ HAND = {
 
 
 def _hidden_hand(rng):
-    """HAND's kinds with other numbers (tasks along the axes, a partial and a full conflict,
-    J1 = 0, a rank-1 J1 whose null space J2 reaches, full-rank J1 without damping)."""
-    def vec(n):
-        return rng.normal(size=n).round(3)
-
-    a, b, c = rng.uniform(0.5, 2.0, 3).round(3)
-    lam = lambda: round(float(rng.uniform(0.05, 0.5)), 3)  # noqa: E731
-    row = vec(3)
-    rank1 = np.outer([1.0, b], [a, c, 0.0])  # columns 0, 1 only: J2 below uses column 2
-    J2_free = np.array([[0.0, a, 1.0]])
-    full = np.array([[a, 0.0, 0.0], [0.0, b, 0.0]])
-    full4 = rng.normal(size=(2, 4)).round(3)
-    return {
-        "regular": [
-            (np.array([[a, 0.0]]), vec(1), np.array([[0.0, b]]), vec(1), lam(), "independent tasks"),
-            (np.array([[a, 0.0, 0.0]]), vec(1), np.array([[b, c, 0.0]]), vec(1), lam(),
-             "partial conflict"),
-            (row[None], vec(1), row[None], vec(1), lam(), "full conflict: J2 = J1")],
-        "singular": [
-            (np.zeros((2, 3)), vec(2), np.array([[1.0, 0.0, a]]), vec(1), lam(), "singular: J1 = 0"),
-            (rank1, vec(2), J2_free, vec(1), lam(), "singular: rank-1 J1")],
-        "no damping": [
-            (full, vec(2), np.array([[0.0, c, 1.0]]), vec(1), 0.0, "no damping, J1 of full row rank"),
-            (full4, vec(2), vec(4)[None], vec(1), 0.0, "no damping, J1 of full row rank"),
-            (np.zeros((2, 3)), vec(2), np.array([[1.0, 0.0, b]]), vec(1), 0.0,
-             "no damping, singular: J1 = 0"),
-            (rank1, vec(2), J2_free, vec(1), 0.0, "no damping, singular: rank-1 J1")],
-    }
+    """HAND turned (verdicts._turned: J1 and J2 share their columns), the same damping."""
+    def turned(J1, e1, J2, e2, lam, note):
+        (J1, J2), (e1, e2) = _turned(rng, [J1, J2], [e1, e2])
+        return J1, e1, J2, e2, lam, note
+    return {tag: [turned(*case) for case in cases] for tag, cases in HAND.items()}
 
 
 @_in_every_draw
@@ -221,7 +198,6 @@ def _priority_parts(fn, name, seed=None):
 
     def against_reference(tag):
         def check():
-            _check_callable(fn, name)
             for case in (c for c in cases if c.tag == tag):
                 got, want = result(case), case.want(_ref_priority)
                 if not _close(got, want, rtol=1e-6, atol=1e-8):
@@ -230,7 +206,6 @@ def _priority_parts(fn, name, seed=None):
 
     def no_damping():
         """damping = 0: the exact pseudoinverses, finite whether J1 is singular or not."""
-        _check_callable(fn, name)
         for case in (c for c in cases if c.tag == "no damping"):
             try:
                 got = result(case)
@@ -243,7 +218,6 @@ def _priority_parts(fn, name, seed=None):
 
     def primary_kept():
         """J1 delta = J1 J1+ e1: the secondary adds nothing the primary sees (first order)."""
-        _check_callable(fn, name)
         for case in (c for c in cases if c.tag != "no damping"):
             J1, e1, J2, e2, lam = case.args
             got = result(case)

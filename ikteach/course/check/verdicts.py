@@ -81,6 +81,8 @@ def _student_line(exc):
 def _call(fn, name, case, *args, limit=None):
     """fn(*args) under a time limit; student errors become _NotYet/_Fail/_Abort."""
     limit = TIME_LIMIT if limit is None else limit
+    if not callable(fn):
+        raise _Fail(f"expected your function `{name}`, got {type(fn).__name__} {fn!r:.40}")
     try:
         with _time_limit(limit), np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)  # NaN is reported by the check
@@ -130,10 +132,6 @@ def _fmt(x, digits=4):
         return np.array2string(arr, separator=", ").replace("\n", "")
 
 
-def _shown(got, want):
-    """got and want printed with as many digits as it takes to tell them apart (4 at least)."""
-    digits = next((d for d in range(4, 17) if _fmt(got, d) != _fmt(want, d)), 17)
-    return _fmt(got, digits), _fmt(want, digits)
 
 
 @dataclasses.dataclass
@@ -167,7 +165,8 @@ def _close(a, b, rtol=1e-6, atol=1e-9, scale=None):
 def _mismatch(got, want, case, what="the step"):
     label, yours = f"expected {what}:", "your result:" if what == "the step" else f"your {what}:"
     width = max(len(label), len(yours))
-    got, want = _shown(got, want)
+    digits = next((d for d in range(4, 17) if _fmt(got, d) != _fmt(want, d)), 17)
+    got, want = _fmt(got, digits), _fmt(want, digits)  # to the digits that differ
     return (f"\n  smallest failing case: {case}\n  {label:<{width}} {want}"
             f"\n  {yours:<{width}} {got}")
 
@@ -187,20 +186,28 @@ def _in_every_draw(cases):
     return functools.wraps(cases)(drawn)
 
 
+def _turned(rng, Js, es):
+    """A hand case's counterpart for the seed: each J (they share columns) with rows and
+    columns reordered and flipped (signed permutations), each e with its J's rows, scaled by
+    a power of 2 - exactly the same singular values, ranks, zeros and ties (the same kind, as
+    hard), other numbers."""
+    def signed(n):
+        return np.eye(n)[rng.permutation(n)] * rng.choice([-1.0, 1.0], n)
+    Q, scale = signed(Js[0].shape[1]), 2.0 ** float(rng.choice([-1, 1, 2]))
+    Ps = [signed(len(J)) for J in Js]
+    return ([P @ J @ Q + 0.0 for P, J in zip(Ps, Js)],
+            [scale * (P @ e) + 0.0 for P, e in zip(Ps, es)])
+
+
 def _rng(seed, offset):
     """The cases' random generator: seed None gives the instant check's (SEED + offset: what a
     student sees in the notebook), an int the grader's hidden cases (drawn at grading time)."""
     return np.random.default_rng(SEED + offset if seed is None else [int(seed), offset])
 
 
-def _random_matrix(rng, m, n, cond_max=1e3):
+def _random_matrix(rng, m, n):
     """A random m x n matrix with singular values in [1, 10] (well conditioned)."""
-    U, _ = np.linalg.qr(rng.normal(size=(m, m)))
-    V, _ = np.linalg.qr(rng.normal(size=(n, n)))
-    k = min(m, n)
-    S = np.zeros((m, n))
-    S[np.arange(k), np.arange(k)] = rng.uniform(1.0, 10.0, size=k)
-    return U @ S @ V.T
+    return _with_singular_values(rng, rng.uniform(1.0, 10.0, size=min(m, n)), m, n)
 
 
 def _with_singular_values(rng, sigma, m, n):
@@ -279,18 +286,3 @@ def _evaluate(number, name, function_names, parts):
     marks = "  ".join(f"{p.name} {'ok' if results.get(p.name) else 'x'}" for p in parts)
     return Verdict(number, name, "failed", score, total,
                    f"{title}: {score:g}/{total:g} - {first_failure}\n  parts: {marks}", results)
-
-
-def _check_callable(fn, name):
-    if not callable(fn):
-        raise _Fail(f"expected your function `{name}`, got {type(fn).__name__} {fn!r:.40}")
-
-
-
-def _guarded(fn, name, make_parts):
-    """Parts for fn, or one failing part when fn is not a function."""
-    if not callable(fn):
-        def bad():
-            raise _Fail(f"expected your function `{name}`, got {type(fn).__name__}")
-        return [_Part("function", POINTS, bad)]
-    return make_parts(fn, name)
