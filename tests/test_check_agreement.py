@@ -123,10 +123,17 @@ def submission(student):
 
 F32 = np.float32
 FLOAT32 = "returns float32; return float64"
+
+
+def out64(fn):
+    """fn computed in float32, its answer handed back as float64: judged by its digits."""
+    return lambda *args: np.asarray(fn(*args), dtype=np.float64)
+
 # (exercise, functions or a tests/submissions name, marks, words of the message)
 ATTEMPTS = {
     "ex 1 right": (1, [jacobian], 10, "passed"),
     "ex 1 float32": (1, [lambda L, t: jacobian(L, t, F32)], 0, FLOAT32),
+    "ex 1 float32 inside": (1, [out64(lambda L, t: jacobian(L, t, F32))], 10, "passed"),
     "ex 1 a sign slip in row 0 only": (1, [row_0_sign_slip], 2, "row 0 has the wrong sign"),
     "ex 1 sign_error": (1, "sign_error", 6, "wrong sign"),
     "ex 2 right": (2, [jt], 10, "passed"),
@@ -137,6 +144,7 @@ ATTEMPTS = {
     "ex 3 np.linalg.pinv(J, rcond)": (3, [lambda J, e, r: np.linalg.pinv(J, rcond=r) @ e], 10,
                                        "passed"),
     "ex 3 float32": (3, [pinv_cut(dtype=F32)], 0, FLOAT32),
+    "ex 3 float32 inside": (3, [out64(pinv_cut(dtype=F32))], 7, "wrong values"),
     "ex 3 no_cutoff": (3, "no_cutoff", 7, "no cut-off"),
     "ex 3 np.linalg.pinv(J)": (3, [lambda J, e, r: np.linalg.pinv(J) @ e], 7, "no cut-off"),
     "ex 3 a fixed cut-off of 1e-3": (3, [pinv_cut(1e-3)], 7, "ignores `rcond`"),
@@ -145,6 +153,8 @@ ATTEMPTS = {
     "ex 4 both forms": (4, [dls_m, dls_n], 10, "passed"),
     "ex 4 float32": (4, [lambda J, e, d: dls_m(J, e, d, F32), lambda J, e, d: dls_n(J, e, d, F32)],
                      0, FLOAT32),
+    "ex 4 float32 inside": (4, [out64(lambda J, e, d: dls_m(J, e, d, F32)),
+                                out64(lambda J, e, d: dls_n(J, e, d, F32))], 0, "wrong values"),
     "ex 4 a method object beside an own normal form": (
         4, [dls_method_object, dls_n], 4, "`dls_step` raised ReferenceBlocked"),
     "ex 4 the n x n form twice": (4, [dls_n, dls_n], 8, "the m x m solve"),

@@ -24,7 +24,13 @@ REFERENCES = ("ikteach.core.dls:dls_step",
 
 HAND = [(np.array([[0.0, 0.0], [3.0, 2.0]]), np.array([1.0, 0.5]), 0.5, "singular J"),
         (np.zeros((2, 3)), np.array([1.0, -1.0]), 0.3, "zero J"),
-        (np.eye(2), np.array([1.0, 2.0]), 0.5, "")]
+        (np.eye(2), np.array([1.0, 2.0]), 0.5, ""),
+        # the smallest damping drawn, where a form's own matrix is singular (J J^T for a tall J,
+        # J^T J for a wide one): a form solved with too few digits fails here, in every draw
+        (np.array([[-0.6, 0.1], [0.4, 1.6], [0.9, -0.1]]), np.array([0.7, -0.4, 0.2]), 0.05,
+         "tall J, small damping"),
+        (np.array([[-0.6, 0.4, 0.9], [0.1, 1.6, -0.1]]), np.array([0.7, -0.4]), 0.05,
+         "wide J, small damping")]
 
 
 def _hidden_hand(rng):
