@@ -132,8 +132,6 @@ def _fmt(x, digits=4):
         return np.array2string(arr, separator=", ").replace("\n", "")
 
 
-
-
 @dataclasses.dataclass
 class _Case:
     args: tuple
