@@ -31,8 +31,8 @@ def _singular_hand(rng):
         (np.array([[1.0, 1.0], [1.0, 1.0]]), np.array([1.0, -1.0]), 1e-6),
         (_with_singular_values(rng, [1.0, 1e-9], 2, 3).round(12), np.array([0.3, 0.4]), 1e-6),
         (_with_singular_values(rng, [100.0, 1e-5], 2, 2), np.array([1.0, 1.0]), 1e-6),
-        # a small J (sigma_max below every hidden case's): the cut-off is relative, the step
-        # is not zero (nor is it for a guard at a fixed size of sigma_max)
+        # a small J (sigma_max 5e-5): the cut-off is relative, the step is not zero (a guard
+        # "sigma_max < 1e-4: zero step" loses the cut-off's marks here, in every draw)
         (_with_singular_values(rng, [5e-5, 5e-10], 2, 3), np.array([0.2, -0.1]), 1e-4),
         # sigma_min / sigma_max between 1e-5 and 0.1: rcond decides, on either side
         (_with_singular_values(rng, [1.0, 1e-3], 2, 3), np.array([0.5, -0.2]), 1e-6),
