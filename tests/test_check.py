@@ -399,3 +399,13 @@ def test_stop_solve_hook_ends_the_solve_stalled():
     # at the target the step is 0, the rule fires, and the solve still ends "converged"
     res = ik.solve(arm, np.asarray(ik.fk(arm, theta0)), theta0, method=step, stall_tol=0)
     assert (res.status, res.iterations) == ("converged", 0)
+
+
+def test_feedback_prints_the_digits_that_differ():
+    """A Jacobian 3e-6 too long: expected and yours differ in the sixth digit, and are printed
+    to it (not identically to four), with a word on float32 (issue 48)."""
+    verdict = check.jacobian_verdict(lambda L, t: planar_jacobian(L, t) * (1 + 3e-6))
+    lines = {line.split(":")[0].strip(): line.split(":", 1)[1] for line in
+             verdict.message.splitlines() if line.strip().startswith(("expected J", "your J"))}
+    assert lines["expected J"].strip() != lines["your J"].strip(), verdict.message
+    assert "they agree to 6 digits only: is something computed in float32?" in verdict.message

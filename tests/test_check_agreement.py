@@ -144,7 +144,7 @@ ATTEMPTS = {
     "ex 3 np.linalg.pinv(J, rcond)": (3, [lambda J, e, r: np.linalg.pinv(J, rcond=r) @ e], 10,
                                        "passed"),
     "ex 3 float32": (3, [pinv_cut(dtype=F32)], 0, FLOAT32),
-    "ex 3 float32 inside": (3, [out64(pinv_cut(dtype=F32))], 7, "wrong values"),
+    "ex 3 float32 inside": (3, [out64(pinv_cut(dtype=F32))], 7, "computed in float32?"),
     "ex 3 no_cutoff": (3, "no_cutoff", 7, "no cut-off"),
     "ex 3 np.linalg.pinv(J)": (3, [lambda J, e, r: np.linalg.pinv(J) @ e], 7, "no cut-off"),
     "ex 3 a fixed cut-off of 1e-3": (3, [pinv_cut(1e-3)], 7, "ignores `rcond`"),
@@ -154,7 +154,8 @@ ATTEMPTS = {
     "ex 4 float32": (4, [lambda J, e, d: dls_m(J, e, d, F32), lambda J, e, d: dls_n(J, e, d, F32)],
                      0, FLOAT32),
     "ex 4 float32 inside": (4, [out64(lambda J, e, d: dls_m(J, e, d, F32)),
-                                out64(lambda J, e, d: dls_n(J, e, d, F32))], 0, "wrong values"),
+                                out64(lambda J, e, d: dls_n(J, e, d, F32))], 0,
+                            "computed in float32?"),
     "ex 4 a method object beside an own normal form": (
         4, [dls_method_object, dls_n], 4, "`dls_step` raised ReferenceBlocked"),
     "ex 4 the n x n form twice": (4, [dls_n, dls_n], 8, "the m x m solve"),

@@ -163,10 +163,14 @@ def _close(a, b, rtol=1e-6, atol=1e-9, scale=None):
 def _mismatch(got, want, case, what="the step"):
     label, yours = f"expected {what}:", "your result:" if what == "the step" else f"your {what}:"
     width = max(len(label), len(yours))
+    gap = (np.max(np.abs(got - want), initial=0.0) / max(np.max(np.abs(want)), 1e-300)
+           if np.shape(got) == np.shape(want) and np.size(want) else np.inf)
+    hint = (f"\n  they agree to {-np.log10(gap):.0f} digits only: is something computed in "
+            "float32?" if 1e-8 < gap < 1e-3 else "")  # float64 keeps about 16
     digits = next((d for d in range(4, 17) if _fmt(got, d) != _fmt(want, d)), 17)
     got, want = _fmt(got, digits), _fmt(want, digits)  # to the digits that differ
     return (f"\n  smallest failing case: {case}\n  {label:<{width}} {want}"
-            f"\n  {yours:<{width}} {got}")
+            f"\n  {yours:<{width}} {got}{hint}")
 
 
 def _shape_message(name, got, want, case, hint=""):
