@@ -408,4 +408,5 @@ def test_feedback_prints_the_digits_that_differ():
     lines = {line.split(":")[0].strip(): line.split(":", 1)[1] for line in
              verdict.message.splitlines() if line.strip().startswith(("expected J", "your J"))}
     assert lines["expected J"].strip() != lines["your J"].strip(), verdict.message
+    assert "1.000003" in lines["your J"] and "1.000003" not in lines["expected J"]
     assert "they agree to 6 digits only: is something computed in float32?" in verdict.message

@@ -123,7 +123,7 @@ def _as_array(value, name, case):
 # --- cases and comparisons -------------------------------------------------------------------
 
 def _fmt(x, digits=4):
-    arr = np.asarray(x, dtype=float)
+    arr = np.asarray(x, dtype=float) + 0.0  # -0.0 printed as 0.
     if arr.ndim == 0:
         return f"{float(arr):.{digits}g}"
     small = 0 < np.abs(arr).max(initial=0.0) < 1e-3  # a small J in e-notation, not as zeros
