@@ -20,9 +20,9 @@ NUMBERS = tuple(sorted(EXERCISES))
 
 def grade(number, namespace, seed=None):
     """The verdict for exercise `number`, taking the student's functions from `namespace`
-    (a dict: a notebook's globals, or the grader's proxies), on the hidden cases drawn from
-    `seed` (None: the instant check's cases). Missing functions fail with a message; nothing
-    is printed."""
+    (a dict: a notebook's globals, or the grader's proxies), on the instant check's cases and
+    the hidden ones drawn from `seed` (None: the instant check's only). Missing functions fail
+    with a message; nothing is printed."""
     if number not in EXERCISES:
         raise ValueError(f"number: expected one of {sorted(EXERCISES)}, got {number!r}")
     module = EXERCISES[number]

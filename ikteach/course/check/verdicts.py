@@ -203,7 +203,7 @@ def _turned(rng, Js, es):
 
 def _rng(seed, offset):
     """The cases' random generator: seed None gives the instant check's (SEED + offset: what a
-    student sees in the notebook), an int the grader's hidden cases (drawn at grading time)."""
+    student sees in the notebook), an int the grader's added cases (drawn at grading time)."""
     return np.random.default_rng(SEED + offset if seed is None else [int(seed), offset])
 
 
