@@ -294,7 +294,7 @@ def jacobian_from_ikteach(lengths, theta):
     (2, [ik.jt_step], "ikteach.core.jt.jt_step"),
     (3, [lambda J, e, r: ik.pinv_step(J, e, r)], "ikteach.core.pinv.pinv_step"),
     (4, [ik.dls_step, lambda J, e, l: np.asarray(ik.dls_step_normal(J, e, l))],
-     "ikteach.core.dls.dls_step, ikteach.core.dls.dls_step_normal"),
+     "ikteach.core.dls.dls_step"),
     (7, [lambda *a: ik.priority_step(*a)], "ikteach.core.priority.priority_step"),
 ])
 def test_a_wrapper_of_ikteachs_answer_is_told_what_the_grader_gives(number, functions,
@@ -306,7 +306,8 @@ def test_a_wrapper_of_ikteachs_answer_is_told_what_the_grader_gives(number, func
     verdict = getattr(check, f"{module.CHECK_NAME}_verdict")(*functions)
     assert verdict.score == 0 and f"calls ikteach's own answer to this exercise ({reference})" \
         in verdict.message, verdict.message
-    assert "raise ReferenceBlocked, so this gets 0/10 there" in verdict.message
+    assert "raised ReferenceBlocked: your code calls" in verdict.message
+    assert "which raises ReferenceBlocked in the grader" in verdict.message
     getattr(check, module.CHECK_NAME)(*functions)
     assert capsys.readouterr().out.strip() == verdict.message
 
@@ -338,27 +339,38 @@ def priority_from_lecture_parts(J1, e1, J2, e2, damping):
     return first + N1 @ (np.asarray(ik.damped_pinv(J2 @ N1, damping)) @ (e2 - J2 @ first))
 
 
-@pytest.mark.parametrize("number, functions, reference", [
-    (2, [jt_imported_inside], "ikteach.core.jt.jt_step"),
-    (2, [jt_by_getattr], "ikteach.core.jt.jt_step"),
+@pytest.mark.parametrize("number, functions, reference, marks", [
+    (2, [jt_imported_inside], "ikteach.core.jt.jt_step", 0),
+    (2, [jt_by_getattr], "ikteach.core.jt.jt_step", 0),
     (5, [lambda d, L, f: bool(ik.core.stop_rules.joint_steps(d) < f * np.sum(L)),
-         stop_rule_step], "ikteach.core.stop_rules.joint_steps"),  # an attribute chain
-    (4, [dls_by_method_object, dls_by_method_table], "ikteach.core.dls.damped_step"),
+         stop_rule_step], "ikteach.core.stop_rules.joint_steps", 5),  # an attribute chain;
+    # the solve part's own stop_rule_step keeps its 5 (in the grader too: only `stalled` raises)
+    (4, [dls_by_method_object, dls_by_method_table], "ikteach.core.dls.damped_step", 0),
     (4, [lambda J, e, d: np.asarray(MyDLS(damping=d).step(J, e)), ik.dls_step_normal],
-     "ikteach.core.dls.damped_step"),
+     "ikteach.core.dls.damped_step", 0),
     (3, [lambda J, e, rcond: np.asarray(ik.damped_pinv(J, 0.0)) @ e],  # J^+ at damping 0
-     "ikteach.core.priority.damped_pinv"),
+     "ikteach.core.priority.damped_pinv", 0),
     (7, [priority_from_lecture_parts], "ikteach.core.priority.damped_pinv, "
-                                       "ikteach.core.priority.null_projector"),
+                                       "ikteach.core.priority.null_projector", 0),
 ])
 def test_every_path_to_the_reference_is_refused_by_the_instant_check(number, functions,
-                                                                      reference):
+                                                                      reference, marks):
     """Function-level imports, getattr with a name, attribute chains, method objects, the
     method table, a subclass, the lecture's parts of exercise 7: the grader's sandbox stubs
-    every one of them (test_reference_rule.py), so the instant check says 0 too."""
+    every one of them (test_reference_rule.py), so the instant check gives what it gives."""
     module = check.EXERCISES[number]
     verdict = getattr(check, f"{module.CHECK_NAME}_verdict")(*functions)
-    assert verdict.score == 0 and reference in verdict.message, verdict.message
+    assert verdict.score == marks and reference in verdict.message, verdict.message
+
+
+def test_a_method_object_in_one_function_costs_that_function_only():
+    """ik.DLS(damping).step in `dls_step` beside an own normal form: the grader's stub raises
+    in `dls_step` only, so the check cell gives what the grader gives, 4 (issue 48)."""
+    def dls_step_normal(J, e, damping):
+        return np.linalg.solve(J.T @ J + damping**2 * np.eye(J.shape[1]), J.T @ e)
+    verdict = check.dls_step_verdict(dls_by_method_object, dls_step_normal)
+    assert verdict.score == 4 and verdict.parts["dls_step_normal"], verdict.message
+    assert "`dls_step` raised ReferenceBlocked" in verdict.message
 
 
 def test_other_ikteach_functions_are_fine_in_the_instant_check():
@@ -387,3 +399,14 @@ def test_stop_solve_hook_ends_the_solve_stalled():
     # at the target the step is 0, the rule fires, and the solve still ends "converged"
     res = ik.solve(arm, np.asarray(ik.fk(arm, theta0)), theta0, method=step, stall_tol=0)
     assert (res.status, res.iterations) == ("converged", 0)
+
+
+def test_feedback_prints_the_digits_that_differ():
+    """A Jacobian 3e-6 too long: expected and yours differ in the sixth digit, and are printed
+    to it (not identically to four), with a word on float32 (issue 48)."""
+    verdict = check.jacobian_verdict(lambda L, t: planar_jacobian(L, t) * (1 + 3e-6))
+    lines = {line.split(":")[0].strip(): line.split(":", 1)[1] for line in
+             verdict.message.splitlines() if line.strip().startswith(("expected J", "your J"))}
+    assert lines["expected J"].strip() != lines["your J"].strip(), verdict.message
+    assert "1.000003" in lines["your J"] and "1.000003" not in lines["expected J"]
+    assert "they agree to 6 digits only: is something computed in float32?" in verdict.message

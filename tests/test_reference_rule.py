@@ -110,6 +110,14 @@ def dls_step_normal(J, e, damping):
     method = ik.core.methods.METHODS["dls"](damping=damping)
     return np.asarray(method.step(np.asarray(J), np.asarray(e)))
 '''
+METHOD_OBJECT_ONE = '''\
+def dls_step(J, e, damping):
+    return np.asarray(ik.DLS(damping).step(J, e))
+
+
+def dls_step_normal(J, e, damping):
+    return np.linalg.solve(J.T @ J + damping**2 * np.eye(J.shape[1]), J.T @ e)
+'''
 LECTURE_PARTS = '''\
 def priority_step(J1, e1, J2, e2, damping):
     N1 = np.asarray(ik.null_projector(J1))
@@ -189,12 +197,14 @@ SPELLINGS = [
     ("method_object", 4, METHOD_OBJECT, 0, "raised ReferenceBlocked: ikteach's damped_step",
      False),
     ("lecture_parts", 7, LECTURE_PARTS, 0, "`priority_step` raised ReferenceBlocked", False),
+    ("method_object_one", 4, METHOD_OBJECT_ONE, 4, "`dls_step` raised ReferenceBlocked", False),
     # the grader's own work on a student's file is bounded: graded as usual, nothing reported
     ("fingerprint_stall", 2, None, 10, "passed, 10/10", False),
 ]
 FUNCTION = {1: "planar_jacobian", 2: "jt_step", 3: "pinv_step", 4: "dls_step", 5: "stalled",
             7: "priority_step"}
-AGREE = ("import_inside", "attribute_chain", "method_object", "lecture_parts")
+AGREE = ("import_inside", "attribute_chain", "method_object", "lecture_parts",
+         "method_object_one")
 
 
 def write_student(subs, student, number, source):
@@ -256,7 +266,7 @@ def test_the_log_records_the_hidden_cases_seed(graded):
 
 @pytest.mark.parametrize("student", AGREE)
 def test_instant_check_agrees(graded, student):
-    """The check cell gives what the grader gave: 0, naming ikteach's function (issue 40)."""
+    """The check cell gives what the grader gave, naming ikteach's function (issues 40, 48)."""
     rows, _, _ = graded
     number, source = next((n, src) for name, n, src, *_ in SPELLINGS if name == student)
     namespace = {"np": np, "ik": __import__("ikteach")}
@@ -264,5 +274,6 @@ def test_instant_check_agrees(graded, student):
     module = check.EXERCISES[number]
     verdict = getattr(check, f"{module.CHECK_NAME}_verdict")(
         *(namespace[n] for n in module.FUNCTIONS))
-    assert verdict.score == float(rows[student][f"ex{number}"]) == 0, verdict.message
+    marks = next(m for name, _, _, m, *_ in SPELLINGS if name == student)
+    assert verdict.score == float(rows[student][f"ex{number}"]) == marks, verdict.message
     assert "calls ikteach's own answer to this exercise" in verdict.message

@@ -3,10 +3,11 @@
 Each check runs the student's function on hand-picked cases (singular ones included) and on
 seeded random ones, compares with the module's own reference (ik.jacobian, ik.jt_step,
 ik.pinv_step, ik.dls_step, ik.solve), and prints either "passed" or what is wrong, with the
-smallest failing case. Whatever the student's code does (raises, returns NaN or the wrong
-type, loops forever) becomes a message, never a traceback from ikteach. Every exercise is
+smallest failing case. Whatever the student's code does (raises, returns NaN, float32 or the
+wrong type, loops forever) becomes a message, never a traceback from ikteach. Every exercise is
 worth POINTS, split into parts; ``<name>_verdict(...)`` returns the Verdict without printing,
-``grade(number, namespace, seed)`` is what the grader calls (on hidden cases drawn from seed).
+``grade(number, namespace, seed)`` is what the grader calls: the check cell's cases, in every
+draw, and as many again drawn from the seed (the same kinds, other numbers).
 
 Layout: ``verdicts.py`` (running student code under a time limit, cases, comparisons, scoring
 by parts, the Verdict), one module per exercise (``ex01_jacobian.py`` ...), ``registry.py``
@@ -18,8 +19,8 @@ exercise numbers and grades.csv's columns derive from the files) with
     FUNCTIONS = ("student_fn", ...)        # the names the template defines, in call order
     REFERENCES = ("ikteach.core.x:fn", ...)  # ikteach's own answer: stubbed in the grader's
                                            # sandbox (grading/reference.py)
-    def verdict(*functions, seed=None) -> Verdict   # cases from verdicts._rng(seed, N): the
-                                           # instant check's for None, hidden ones otherwise;
+    def verdict(*functions, seed=None) -> Verdict   # cases: @_in_every_draw def cases(seed)
+                                           # (None: the check cell's; a seed: its own extra);
                                            # build [_Part(name, points, run), ...] (points sum
                                            # to POINTS; run() returns None or the message of
                                            # the smallest failing case) and return

@@ -7,8 +7,8 @@ import numpy as np
 
 from ...core.chain import planar_chain
 from ...core.jacobian import jacobian as _ref_jacobian
-from .verdicts import (_Case, _Fail, _Part, _as_array, _call, _close, _evaluate, _fmt,
-                       _guarded, _mismatch, _rng, _shape_message)
+from .verdicts import (_as_array, _call, _Case, _close, _evaluate, _Fail, _fmt, _in_every_draw,
+                       _mismatch, _Part, _rng, _shape_message)
 
 NUMBER = 1
 CHECK_NAME = "jacobian"
@@ -33,18 +33,13 @@ HAND = [([1.0], [0.0], "regular"), ([1.0, 1.0], [0.5, 0.0], "singular"),
 
 
 def _hidden_hand(rng):
-    """HAND's kinds with other numbers: one link, straight and folded arms, two links."""
-    def lengths(n):
-        return rng.uniform(0.5, 1.5, n).round(3).tolist()
-
-    def angle():
-        return round(float(rng.uniform(-np.pi, np.pi)), 3)
-
-    return [(lengths(1), [angle()], "regular"), (lengths(2), [angle(), 0.0], "singular"),
-            (lengths(2), [angle(), np.pi], "singular"), (lengths(2), [angle(), angle()], "regular"),
-            (lengths(3), [angle(), 0.0, 0.0], "singular")]
+    """HAND turned: the base angle drawn, the lengths scaled by a power of 2 (the joint angles
+    that make an arm straight or folded kept)."""
+    return [((np.array(L) * 2.0 ** float(rng.choice([-1, 1]))).tolist(),
+             [round(float(rng.uniform(-np.pi, np.pi)), 3)] + t[1:], tag) for L, t, tag in HAND]
 
 
+@_in_every_draw
 def _jacobian_cases(seed=None):
     rng = _rng(seed, 0)
     cases = list(HAND if seed is None else _hidden_hand(rng))
@@ -86,8 +81,9 @@ def _diagnose_jacobian(got, want, case):
 
 def _columns_up_to_sign(got, want):
     """Every column equals the expected one or its negative (lever arm right, sign aside)."""
+    scale = np.abs(want).max(initial=0.0)  # the case's, not each column's: as in _close
     return got.shape == want.shape and bool(np.all(np.isfinite(got))) and all(
-        _close(g, w) or _close(g, -w) for g, w in zip(got.T, want.T))
+        _close(g, w, scale=scale) or _close(g, -w, scale=scale) for g, w in zip(got.T, want.T))
 
 
 def _jacobian_parts(fn, name, seed=None):
@@ -104,14 +100,14 @@ def _jacobian_parts(fn, name, seed=None):
     def compared(tag):
         """(case, got, want) of the cases with `tag`, shapes checked first."""
         for case in (c for c in cases if c.tag == tag):
-            got, want = result(case), _jacobian_reference(*case.args)
+            got, want = result(case), case.want(_jacobian_reference)
             if got.shape != want.shape:
                 raise _Fail(_shape_message(name, got, want, case))
             yield case, got, want
 
     def shape():
         for case in cases:
-            got, want = result(case), _jacobian_reference(*case.args)
+            got, want = result(case), case.want(_jacobian_reference)
             if got.shape != want.shape:
                 hint = (" - one row per coordinate (x, y), one column per joint: transposed?"
                         if got.shape == want.T.shape else " - (2, number of joints)")
@@ -139,5 +135,4 @@ def _jacobian_parts(fn, name, seed=None):
 
 def verdict(planar_jacobian, seed=None):
     """Verdict for exercise 1 without printing (`seed`: the grader's hidden cases)."""
-    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _guarded(
-        planar_jacobian, FUNCTIONS[0], lambda fn, name: _jacobian_parts(fn, name, seed)))
+    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _jacobian_parts(planar_jacobian, FUNCTIONS[0], seed))

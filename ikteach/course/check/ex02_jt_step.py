@@ -6,8 +6,8 @@ J J^T e = 0 2.
 import numpy as np
 
 from ...core.jt import jt_step as _ref_jt
-from .verdicts import (_Case, _Fail, _Part, _as_array, _call, _close, _evaluate, _guarded,
-                       _matrix_text, _mismatch, _rng, _shape_message)
+from .verdicts import (_as_array, _call, _Case, _close, _evaluate, _Fail, _in_every_draw,
+                       _matrix_text, _mismatch, _Part, _rng, _shape_message, _turned)
 
 NUMBER = 2
 CHECK_NAME = "jt_step"
@@ -35,17 +35,11 @@ HAND = [(np.eye(2), np.array([1.0, 0.0]), "regular"),
 
 
 def _hidden_hand(rng):
-    """HAND's kinds with other numbers: a scaled identity, a diagonal J, e = 0, e orthogonal
-    to every column of J (a zero row), J = 0."""
-    a, b, c = rng.uniform(0.5, 2.0, 3).round(3)
-    n = int(rng.integers(2, 5))
-    return [(a * np.eye(2), rng.normal(size=2).round(3), "regular"),
-            (np.diag([a, b, c])[:2], rng.normal(size=2).round(3), "regular"),
-            (rng.normal(size=(2, n)).round(3), np.zeros(2), "zero"),
-            (np.vstack([rng.normal(size=n).round(3), np.zeros(n)]), np.array([0.0, c]), "zero"),
-            (np.zeros((2, n + 1)), rng.normal(size=2).round(3), "zero")]  # not square
+    """HAND turned (verdicts._turned)."""
+    return [(*(x[0] for x in _turned(rng, [J], [e])), tag) for J, e, tag in HAND]
 
 
+@_in_every_draw
 def _jt_cases(seed=None):
     rng = _rng(seed, 2)
     hand = []
@@ -76,7 +70,7 @@ def _jt_parts(fn, name, seed=None):
         return c, _close(got, c * g)
 
     def _ref(case):
-        return np.asarray(_ref_jt(*case.args))
+        return case.want(_ref_jt)
 
     regular = [c for c in cases if c.tag == "regular"]
 
@@ -142,5 +136,4 @@ def _jt_parts(fn, name, seed=None):
 
 def verdict(jt_step, seed=None):
     """Verdict for exercise 2 without printing (`seed`: the grader's hidden cases)."""
-    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _guarded(
-        jt_step, FUNCTIONS[0], lambda fn, name: _jt_parts(fn, name, seed)))
+    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _jt_parts(jt_step, FUNCTIONS[0], seed))

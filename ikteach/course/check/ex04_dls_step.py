@@ -6,9 +6,9 @@ form is defined for a wide J, the n x n form for a tall one, where the other is 
 import numpy as np
 
 from ...core.dls import dls_step as _ref_dls
-from .verdicts import (_Case, _Fail, _Part, _as_array, _call, _check_callable, _close,
-                       _evaluate, _fmt, _matrix_text, _mismatch, _random_matrix, _rng,
-                       _shape_message)
+from .verdicts import (_as_array, _call, _Case, _close, _evaluate, _Fail, _fmt, _in_every_draw,
+                       _matrix_text, _mismatch, _Part, _random_matrix, _rng, _shape_message,
+                       _turned)
 
 NUMBER = 4
 CHECK_NAME = "dls_step"
@@ -24,19 +24,21 @@ REFERENCES = ("ikteach.core.dls:dls_step",
 
 HAND = [(np.array([[0.0, 0.0], [3.0, 2.0]]), np.array([1.0, 0.5]), 0.5, "singular J"),
         (np.zeros((2, 3)), np.array([1.0, -1.0]), 0.3, "zero J"),
-        (np.eye(2), np.array([1.0, 2.0]), 0.5, "")]
+        (np.eye(2), np.array([1.0, 2.0]), 0.5, ""),
+        # the smallest damping drawn, where a form's own matrix is singular (J J^T for a tall J,
+        # J^T J for a wide one): a form solved with too few digits fails here, in every draw
+        (np.array([[-0.6, 0.1], [0.4, 1.6], [0.9, -0.1]]), np.array([0.7, -0.4, 0.2]), 0.05,
+         "tall J, small damping"),
+        (np.array([[-0.6, 0.4, 0.9], [0.1, 1.6, -0.1]]), np.array([0.7, -0.4]), 0.05,
+         "wide J, small damping")]
 
 
 def _hidden_hand(rng):
-    """HAND's kinds with other numbers: a straight arm's J, J = 0, a scaled identity."""
-    a, b, c = rng.uniform(0.5, 3.0, 3).round(3)
-    lams = rng.uniform(0.1, 0.9, 3).round(3)
-    return [(np.array([[0.0, 0.0], [a, b]]), rng.normal(size=2).round(3), lams[0], "singular J"),
-            (np.zeros((2, int(rng.integers(3, 5)))), rng.normal(size=2).round(3), lams[1],
-             "zero J"),
-            (c * np.eye(2), rng.normal(size=2).round(3), lams[2], "")]
+    """HAND turned (verdicts._turned), the same damping."""
+    return [(*(x[0] for x in _turned(rng, [J], [e])), lam, note) for J, e, lam, note in HAND]
 
 
+@_in_every_draw
 def _dls_cases(seed=None):
     rng = _rng(seed, 4)
     cases = []
@@ -55,6 +57,7 @@ def _dls_cases(seed=None):
     return sorted(cases, key=lambda c: c.size)
 
 
+@_in_every_draw
 def _form_cases(seed=None):
     """Damping 0, where only one form is defined: a wide J of full row rank (J J^T invertible,
     the n x n J^T J singular) for the m x m form, a tall J of full column rank for the n x n
@@ -115,7 +118,6 @@ def _dls_parts(fns, names, seed=None):
         name = names[which]
 
         def check():
-            _check_callable(fns[which], name)
             first = None  # (case, got or None, error or None): the smallest failing case
             for case in cases:
                 try:
@@ -125,7 +127,7 @@ def _dls_parts(fns, names, seed=None):
                         raise
                     first = first or (case, None, str(exc))
                     continue
-                want = np.asarray(_ref_dls(*case.args))
+                want = case.want(_ref_dls)
                 if got.shape != want.shape:
                     return _shape_message(name, got, want, case, " - one entry per joint")
                 if not _close(got, want):
@@ -135,17 +137,15 @@ def _dls_parts(fns, names, seed=None):
             if undamped(which):
                 case, got, error = first
                 return NO_DAMPING + (f"\n  smallest failing case: {case}\n  {error}" if error
-                                     else _mismatch(got, np.asarray(_ref_dls(*case.args)), case))
+                                     else _mismatch(got, case.want(_ref_dls), case))
             case, got, error = first
             if error is not None:
                 raise _Fail(error)
-            return diagnose(which, got, np.asarray(_ref_dls(*case.args)), case)
+            return diagnose(which, got, case.want(_ref_dls), case)
         return check
 
     def both_forms():
         """The two agree, and each is its own form: at damping 0 only that form is defined."""
-        for which in (0, 1):
-            _check_callable(fns[which], names[which])
         for case in cases:
             a, b = result(0, case), result(1, case)
             if a.shape != b.shape or not _close(a, b):
@@ -153,8 +153,8 @@ def _dls_parts(fns, names, seed=None):
                         "same step, (J^T J + lambda^2 I)^-1 J^T = J^T (J J^T + lambda^2 I)^-1."
                         f"\n  smallest failing case: {case}\n  {names[0]}: {_fmt(a)}"
                         f"\n  {names[1]}: {_fmt(b)}")
-        for which, case in enumerate(_form_cases(seed)):
-            J, e, _ = case.args
+        for k, case in enumerate(_form_cases(seed)):
+            which, (J, e, _) = k % 2, case.args  # wide, tall, wide, tall
             want, other = np.linalg.pinv(J) @ e, ("J^T J", "J J^T")[which]
             try:
                 got = _as_array(_call(fns[which], names[which], case, J.copy(), e.copy(), 0.0),

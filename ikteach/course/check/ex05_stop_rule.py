@@ -1,7 +1,8 @@
 """Exercise 5: stalled(delta_theta, lengths, fraction) and stop_rule_step(step, lengths, fraction).
 
 Parts: the rule 5; the rule ending ik.solve 5 (the returned step function raises ik.StopSolve on
-exactly the rule's cases, then ends an out-of-reach ik.solve "stalled" where the rule says).
+exactly the rule's cases, then ends an out-of-reach ik.solve "stalled" where the rule says: one
+arm and target, in every draw; the seed adds rule cases).
 """
 import functools
 
@@ -12,8 +13,8 @@ from ...core.dls import dls_step as _ref_dls
 from ...core.solve import StopSolve
 from ...core.solve import solve as _solve
 from ..grading.own_code import fixed_step
-from .verdicts import (SOLVE_LIMIT, _Case, _Fail, _Part, _as_array, _call, _check_callable,
-                       _close, _evaluate, _fmt, _rng)
+from .verdicts import (_as_array, _call, _Case, _close, _evaluate, _Fail, _fmt, _in_every_draw,
+                       _Part, _rng, SOLVE_LIMIT)
 
 NUMBER = 5
 CHECK_NAME = "stop_rule"
@@ -81,23 +82,17 @@ HAND = [([0.1, -0.1], [1.0, 1.0], 1e-3), ([2e-3, 0.0, 0.0], [1.0, 1.0, 1.0], 1e-
 
 
 def _hidden_hand(rng):
-    """HAND's kinds with other numbers: opposite steps that cancel, one joint at twice the
-    threshold, every joint at a third of it, long links, mixed signs, one link, exactly at the
-    threshold (binary fractions: the sums are exact), each joint below it but the sum above,
-    each joint below it but the 2-norm above."""
-    f = float(rng.choice([1e-3, 1e-2]))
-    a = float(rng.choice([1, 2, 3, 5, 6, 7])) / 8  # k/8: a * f * 2 is exactly f * (a + a)
-    L2, L3 = (rng.uniform(0.5, 2.0, n).round(3).tolist() for n in (2, 3))
-    t2, t3 = f * sum(L2), f * sum(L3)
-    x = float(rng.uniform(0.02, 0.2))
-    return [([x, -x], rng.uniform(0.5, 2.0, 2).round(3).tolist(), f),
-            ([2 * t3, 0.0, 0.0], L3, f), ([t3 / 3] * 3, L3, f),
-            ([0.05, 0.05], rng.uniform(5.0, 30.0, 2).round(1).tolist(), f),
-            ([-t2 / 2, t2 / 4], L2, f), ([x * 5], [float(rng.uniform(0.5, 2.0))], f),
-            ([f * a, f * a], [a, a], f), ([0.6 * f * a * 2, 0.6 * f * a * 2], [a, a], f),
-            ([0.8 * f * a * 2, 0.8 * f * a * 2], [a, a], f)]
+    """HAND turned: joints reordered, steps and lengths scaled by one power of 2 (the sums and
+    the threshold scale exactly: a case at the threshold stays there)."""
+    out = []
+    for d, L, f in HAND:
+        order, scale = rng.permutation(len(d)), 2.0 ** float(rng.choice([-1, 1, 2]))
+        out.append(((np.array(d)[order] * scale).tolist(), (np.array(L)[order] * scale).tolist(),
+                    f))
+    return out
 
 
+@_in_every_draw
 def _stop_cases(seed=None):
     rng = _rng(seed, 5)
     hand = list(HAND if seed is None else _hidden_hand(rng))
@@ -124,24 +119,14 @@ def _as_bool(value, name, case):
                 "expected True or False")
 
 
-def _stop_setup(seed=None):
-    """(arm lengths, target out of reach, theta0) of the solve part: the instant check's, or
-    drawn (three links, a target 1.2 to 1.5 reaches away, a bent start)."""
-    if seed is None:
-        return STOP_ARM, STOP_TARGET, STOP_THETA0
-    rng = _rng(seed, 50)
-    arm = rng.uniform(0.7, 1.3, 3).round(2).tolist()
-    angle, reach = rng.uniform(-np.pi, np.pi), sum(arm) * rng.uniform(1.2, 1.5)
-    target = [round(float(reach * np.cos(angle)), 2), round(float(reach * np.sin(angle)), 2)]
-    return arm, target, rng.uniform(0.1, 0.4, 3).round(2).tolist()
+_EXPECTED_STOP = {}  # the reference's stalled solve (the same in every draw), run once
 
 
 def _stop_parts(stalled, stop_rule_step, seed=None):
     names = ("stalled", "stop_rule_step")
-    arm_lengths, target, theta0 = _stop_setup(seed)
+    arm_lengths, target, theta0 = STOP_ARM, STOP_TARGET, STOP_THETA0  # in every draw
 
     def rule():
-        _check_callable(stalled, names[0])
         cases = _stop_cases(seed)
         answers = [_as_bool(_call(stalled, names[0], case, case.args[0].copy(),
                                   list(case.args[1]), case.args[2]), names[0], case)
@@ -216,7 +201,6 @@ def _stop_parts(stalled, stop_rule_step, seed=None):
                         f"{text}\n  expected: {_fmt(d)}\n  yours:    {_fmt(got)}")
 
     def solve_part():
-        _check_callable(stop_rule_step, names[1])
         problem = wrapper_on_the_rules_cases()
         if problem is not None:
             return problem
@@ -228,11 +212,13 @@ def _stop_parts(stalled, stop_rule_step, seed=None):
             return (f"`{names[1]}` must return a step function step(J, e) -> delta_theta; "
                     f"it returned {type(step).__name__}.")
         got, text = run_solve(step, names[1])
-        want, _ = run_solve(reference_step, "reference")
+        if not _EXPECTED_STOP:
+            _EXPECTED_STOP["iterations"] = run_solve(reference_step, "reference")[0].iterations
+        want = _EXPECTED_STOP["iterations"]
         detail = (f"\n  case: {text}, target out of reach\n  expected: stalled after "
-                  f"{want.iterations} iterations\n  yours:    {got.status} after "
+                  f"{want} iterations\n  yours:    {got.status} after "
                   f"{got.iterations} iterations")
-        if got.status == "stalled" and abs(got.iterations - want.iterations) <= 1:
+        if got.status == "stalled" and abs(got.iterations - want) <= 1:
             return None
         if got.status == "max_iter":
             return ("the solve never stopped: when the rule fires, raise ik.StopSolve from "

@@ -20,9 +20,9 @@ NUMBERS = tuple(sorted(EXERCISES))
 
 def grade(number, namespace, seed=None):
     """The verdict for exercise `number`, taking the student's functions from `namespace`
-    (a dict: a notebook's globals, or the grader's proxies), on the hidden cases drawn from
-    `seed` (None: the instant check's cases). Missing functions fail with a message; nothing
-    is printed."""
+    (a dict: a notebook's globals, or the grader's proxies), on the instant check's cases and
+    the hidden ones drawn from `seed` (None: the instant check's only). Missing functions fail
+    with a message; nothing is printed."""
     if number not in EXERCISES:
         raise ValueError(f"number: expected one of {sorted(EXERCISES)}, got {number!r}")
     module = EXERCISES[number]
@@ -43,20 +43,33 @@ def refuse(number, message):
                      [_Part("own code", POINTS, lambda: message)])
 
 
+class ReferenceBlocked(Exception):
+    """Raised in the check cell where the grader's sandbox will raise its own ReferenceBlocked
+    (grading/own_code.py): by a graded function that reaches ikteach's own answer."""
+
+
+def _as_graded(fn, references):
+    """fn, or, when fn reaches one of `references`, a stand-in that raises as fn will in the
+    grader's sandbox (where those functions are stubs that raise)."""
+    used = reached([fn], references)
+    if not used:
+        return fn
+    names = ", ".join(ref.replace(":", ".") for ref in used)
+
+    def blocked(*args, **kwargs):
+        raise ReferenceBlocked(
+            f"your code calls ikteach's own answer to this exercise ({names}), which raises "
+            "ReferenceBlocked in the grader: compute the answer in your own code (other ikteach "
+            "functions are fine)")
+    return blocked
+
+
 def instant_verdict(module):
-    """ik.check.<name>_verdict: the module's verdict in the student's notebook, where a graded
-    function that calls ikteach's own answer gets the 0 the grader will give it (the grader's
-    sandbox has those functions only as stubs that raise)."""
+    """ik.check.<name>_verdict: the module's verdict in the student's notebook, a graded
+    function that calls ikteach's own answer getting the marks the grader will give it."""
     def verdict(*functions, seed=None):
-        used = reached(functions, module.REFERENCES)
-        if used:
-            names = ", ".join(ref.replace(":", ".") for ref in used)
-            return refuse(module.NUMBER, (
-                f"your code calls ikteach's own answer to this exercise ({names}). The grader "
-                "runs your notebook where those functions raise ReferenceBlocked, so this gets "
-                f"0/{POINTS} there: compute the answer in your own code (other ikteach "
-                "functions are fine)."))
-        return module.verdict(*functions, seed=seed)
+        graded = [_as_graded(fn, module.REFERENCES) for fn in functions]
+        return module.verdict(*graded, seed=seed)
 
     verdict.__name__ = f"{module.CHECK_NAME}_verdict"
     verdict.__doc__ = f"{module.__doc__.splitlines()[0]}\n\nReturns the Verdict, prints nothing."

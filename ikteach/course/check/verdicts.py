@@ -7,6 +7,7 @@ to _evaluate(number, title, function_names, parts).
 """
 import contextlib
 import dataclasses
+import functools
 import os
 import signal
 import sys
@@ -80,6 +81,8 @@ def _student_line(exc):
 def _call(fn, name, case, *args, limit=None):
     """fn(*args) under a time limit; student errors become _NotYet/_Fail/_Abort."""
     limit = TIME_LIMIT if limit is None else limit
+    if not callable(fn):
+        raise _Fail(f"expected your function `{name}`, got {type(fn).__name__} {fn!r:.40}")
     try:
         with _time_limit(limit), np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)  # NaN is reported by the check
@@ -98,24 +101,34 @@ def _call(fn, name, case, *args, limit=None):
 
 
 def _as_array(value, name, case):
-    """The student's return value as a float array, or a _Fail saying what came back."""
+    """The student's return value as a float64 array, or a _Fail saying what came back. The
+    dtype policy (the same in the check cell and the grader): float64 answers only, since the
+    checks compare to 1e-6 of a case's scale and float32 rounding (1e-7, more after an SVD
+    near a singularity) would make a mark depend on the case drawn."""
     if value is None:
         raise _Fail(f"`{name}` returned None on {case} - did you forget `return`?")
     try:
-        arr = np.array(value, dtype=np.float64)
+        raw = np.asarray(value)
+        arr = np.array(raw, dtype=np.float64)
     except (TypeError, ValueError):
         raise _Fail(f"`{name}` returned {type(value).__name__} {value!r:.60} on {case}; "
                     f"expected an array of numbers") from None
+    if raw.dtype.kind == "f" and raw.dtype.itemsize < 8:
+        raise _Fail(f"`{name}` returns {raw.dtype}; return float64 (the checks work to 1e-6 "
+                    f"of the answer's size, which {raw.dtype} rounding does not always meet) "
+                    f"on {case}")
     return arr
 
 
 # --- cases and comparisons -------------------------------------------------------------------
 
-def _fmt(x):
-    arr = np.asarray(x, dtype=float)
+def _fmt(x, digits=4):
+    arr = np.asarray(x, dtype=float) + 0.0  # -0.0 printed as 0.
     if arr.ndim == 0:
-        return f"{float(arr):.4g}"
-    with np.printoptions(precision=4, suppress=True, floatmode="maxprec", linewidth=200):
+        return f"{float(arr):.{digits}g}"
+    small = 0 < np.abs(arr).max(initial=0.0) < 1e-3  # a small J in e-notation, not as zeros
+    with np.printoptions(precision=digits, suppress=not small, floatmode="maxprec",
+                         linewidth=200):
         return np.array2string(arr, separator=", ").replace("\n", "")
 
 
@@ -125,9 +138,16 @@ class _Case:
     text: str       # how the case is shown to the student
     size: int = 0   # smaller cases are reported first
     tag: str = ""   # which part of the check uses it
+    memo: dict = dataclasses.field(default_factory=dict, repr=False)
 
     def __str__(self):
         return self.text
+
+    def want(self, reference):
+        """reference(*args) as a float array, computed once (a draw's cases are kept)."""
+        if "want" not in self.memo:
+            self.memo["want"] = np.asarray(reference(*self.args), dtype=float)
+        return self.memo["want"]
 
 
 def _close(a, b, rtol=1e-6, atol=1e-9, scale=None):
@@ -141,10 +161,16 @@ def _close(a, b, rtol=1e-6, atol=1e-9, scale=None):
 
 
 def _mismatch(got, want, case, what="the step"):
-    label = f"expected {what}:"
-    width = max(len(label), len("your result:"))
-    return (f"\n  smallest failing case: {case}\n  {label:<{width}} {_fmt(want)}"
-            f"\n  {'your result:':<{width}} {_fmt(got)}")
+    label, yours = f"expected {what}:", "your result:" if what == "the step" else f"your {what}:"
+    width = max(len(label), len(yours))
+    gap = (np.max(np.abs(got - want), initial=0.0) / max(np.max(np.abs(want)), 1e-300)
+           if np.shape(got) == np.shape(want) and np.size(want) else np.inf)
+    hint = (f"\n  they agree to {-np.log10(gap):.0f} digits only: is something computed in "
+            "float32?" if 1e-8 < gap < 1e-3 else "")  # float64 keeps about 16
+    digits = next((d for d in range(4, 17) if _fmt(got, d) != _fmt(want, d)), 17)
+    got, want = _fmt(got, digits), _fmt(want, digits)  # to the digits that differ
+    return (f"\n  smallest failing case: {case}\n  {label:<{width}} {want}"
+            f"\n  {yours:<{width}} {got}{hint}")
 
 
 def _shape_message(name, got, want, case, hint=""):
@@ -152,20 +178,38 @@ def _shape_message(name, got, want, case, hint=""):
             f"{hint}.\n  smallest failing case: {case}")
 
 
+def _in_every_draw(cases):
+    """cases(seed) -> the check cell's cases (seed None) in every draw, the seed's own on top:
+    the hidden seed only adds cases, so what decides a part is decided alike everywhere."""
+    @functools.lru_cache(maxsize=8)  # one draw serves a whole class
+    def drawn(seed=None):
+        own = tuple(cases(seed))
+        return tuple(sorted(own if seed is None else drawn(None) + own, key=lambda c: c.size))
+    return functools.wraps(cases)(drawn)
+
+
+def _turned(rng, Js, es):
+    """A hand case's counterpart for the seed: each J (they share columns) with rows and
+    columns reordered and flipped (signed permutations), each e with its J's rows, scaled by
+    a power of 2 - exactly the same singular values, ranks, zeros and ties (the same kind, as
+    hard), other numbers."""
+    def signed(n):
+        return np.eye(n)[rng.permutation(n)] * rng.choice([-1.0, 1.0], n)
+    Q, scale = signed(Js[0].shape[1]), 2.0 ** float(rng.choice([-1, 1, 2]))
+    Ps = [signed(len(J)) for J in Js]
+    return ([P @ J @ Q + 0.0 for P, J in zip(Ps, Js)],
+            [scale * (P @ e) + 0.0 for P, e in zip(Ps, es)])
+
+
 def _rng(seed, offset):
     """The cases' random generator: seed None gives the instant check's (SEED + offset: what a
-    student sees in the notebook), an int the grader's hidden cases (drawn at grading time)."""
+    student sees in the notebook), an int the grader's added cases (drawn at grading time)."""
     return np.random.default_rng(SEED + offset if seed is None else [int(seed), offset])
 
 
-def _random_matrix(rng, m, n, cond_max=1e3):
+def _random_matrix(rng, m, n):
     """A random m x n matrix with singular values in [1, 10] (well conditioned)."""
-    U, _ = np.linalg.qr(rng.normal(size=(m, m)))
-    V, _ = np.linalg.qr(rng.normal(size=(n, n)))
-    k = min(m, n)
-    S = np.zeros((m, n))
-    S[np.arange(k), np.arange(k)] = rng.uniform(1.0, 10.0, size=k)
-    return U @ S @ V.T
+    return _with_singular_values(rng, rng.uniform(1.0, 10.0, size=min(m, n)), m, n)
 
 
 def _with_singular_values(rng, sigma, m, n):
@@ -244,18 +288,3 @@ def _evaluate(number, name, function_names, parts):
     marks = "  ".join(f"{p.name} {'ok' if results.get(p.name) else 'x'}" for p in parts)
     return Verdict(number, name, "failed", score, total,
                    f"{title}: {score:g}/{total:g} - {first_failure}\n  parts: {marks}", results)
-
-
-def _check_callable(fn, name):
-    if not callable(fn):
-        raise _Fail(f"expected your function `{name}`, got {type(fn).__name__} {fn!r:.40}")
-
-
-
-def _guarded(fn, name, make_parts):
-    """Parts for fn, or one failing part when fn is not a function."""
-    if not callable(fn):
-        def bad():
-            raise _Fail(f"expected your function `{name}`, got {type(fn).__name__}")
-        return [_Part("function", POINTS, bad)]
-    return make_parts(fn, name)
