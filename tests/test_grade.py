@@ -282,8 +282,13 @@ def test_a_job_s_files_stay_within_its_tmpfs(graded):
     assert all(0 < mib <= TMPFS_MB for mib in written.values()), written
 
 
-def test_a_cell_magic_on_each_solution_still_gets_full_marks(graded):
-    assert scores(graded.rows["cell_magic"]) == ([10.0] * 7, 70.0)
+def test_magics_on_each_solution_still_get_full_marks(graded):
+    """%%time or `%matplotlib inline` opening each answer's cell, and a helper the answers call
+    from a cell opening with `%matplotlib inline` and a common line magic (issue 50): they run
+    as in a kernel, shell lines are skipped with a note, and nothing after them is lost."""
+    assert scores(graded.rows["cell_magic"]) == ([10.0] * 7, 70.0), graded.feedback["cell_magic"]
+    assert "`%pip install --quiet ikteach` was skipped" in graded.feedback["cell_magic"]
+    assert "raised" not in graded.feedback["cell_magic"]
 
 
 def test_any_name_gets_one_row_that_no_spreadsheet_runs(graded):
