@@ -8,15 +8,14 @@ With bubblewrap (as root here and in CI) the job is in the sandbox; without it t
 """
 import copy
 import json
-import multiprocessing
 import os
-import subprocess
-import sys
+import signal
+import threading
 from pathlib import Path
 
 import pytest
 
-from ikteach.course import grade
+from ikteach.course import check, grade
 from ikteach.course.grading import report, servers
 from ikteach.course.grading.remote import Worker
 from ikteach.course.grading.sandbox import Sandbox
@@ -183,26 +182,66 @@ def test_what_a_job_says_is_bounded(sandbox):
     assert result["score"] == 0 and len(json.dumps(result)) < 40_000, len(json.dumps(result))
 
 
-def _hog(n):
-    return [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(n)]
+def _jobs():
+    """The students' jobs of this process's sandboxes: children of a fork server (the same
+    command line: a fork) that descend from this test."""
+    table = {}
+    for name in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            with open(f"/proc/{name}/stat", "rb") as stat, open(f"/proc/{name}/cmdline", "rb") as cmd:
+                table[int(name)] = (int(stat.read().rsplit(b")", 1)[1].split()[1]),
+                                    b"grading.forkserver" in cmd.read())
+        except (OSError, ValueError, IndexError):
+            continue
+
+    def ours(pid):
+        while pid > 1 and pid != os.getpid():
+            pid = table.get(pid, (0, False))[0]
+        return pid == os.getpid()
+
+    return [pid for pid, (parent, server) in table.items()
+            if server and table.get(parent, (0, False))[1] and ours(pid)]
 
 
-def test_marks_do_not_depend_on_the_machine_s_load(sandbox):
-    """Exercise 5's solution (its check compiles ik.solve and runs it under a 30 s limit) and
-    exercise 2's, graded quiet and beside two busy processes per core: the same marks."""
+def _busy(done):
+    """A machine busier than any load: the students' jobs get 0.25 s to run in every 1.25 s."""
+    while not done.wait(0.25):
+        frozen = _jobs()
+        for pid in frozen:
+            os.kill(pid, signal.SIGSTOP)
+        done.wait(1.0)
+        for pid in frozen:
+            os.kill(pid, signal.SIGCONT)
+
+
+def test_honest_answers_keep_their_marks_on_a_machine_too_busy_for_their_time_limits(
+        sandbox, monkeypatch):
+    """Exercise 2's solution (the self-check's exercise) and exercise 5's (a solve under a
+    limit, which the grader compiles) graded while their jobs wait 1 s in every 1.25 s, longer
+    than every call's limit (cut to 0.5 s, and 3 s for a solve): the limits count the job's
+    CPU seconds, so the marks are full, on the first run."""
+    monkeypatch.setattr(check.verdicts, "TIME_LIMIT", 0.5)
+    monkeypatch.setattr(check.ex05_stop_rule, "SOLVE_LIMIT", 3.0)
     books = {n: json.loads((ROOT / "instructor" / "solutions" / n).read_text())
              for n in ("02_jt_step.ipynb", "05_stop_rule.ipynb")}
-    quiet = {n: grade.grade_book(n, b, 60, 180, sandbox, seed=3)["score"]
-             for n, b in books.items()}
-    hogs = _hog(2 * multiprocessing.cpu_count())
+    done = threading.Event()
+    busy = threading.Thread(target=_busy, args=(done,))
+    busy.start()
     try:
-        busy = {n: grade.grade_book(n, b, 60, 180, sandbox, seed=3)["score"]
-                for n, b in books.items()}
+        results = [grade.grade_book(n, b, 60, 180, sandbox, seed=3) for n, b in books.items()]
     finally:
-        for hog in hogs:
-            hog.kill()
-            hog.wait()
-    assert quiet == busy == {n: 10.0 for n in books}, (quiet, busy)
+        done.set()
+        busy.join()
+    assert [(r["score"], r["notes"]) for r in results] == [(10.0, [])] * 2, results
+
+
+def test_a_call_held_up_without_using_its_cpu_time_says_the_machine_is_busy(monkeypatch):
+    """A call that waits BUSY times its limit without using the CPU time the limit allows is
+    stopped with the words for what happened (here: the student's own wait)."""
+    monkeypatch.setattr(check.verdicts, "TIME_LIMIT", 0.1)
+    monkeypatch.setattr(check.verdicts, "BUSY", 3)
+    verdict = check.jt_step_verdict(lambda J, e: threading.Event().wait(60))
+    assert verdict.score == 0 and "this machine is busy (or your code waits)" in verdict.message
 
 
 def test_any_two_folders_get_two_rows_and_two_feedback_files():

@@ -18,10 +18,12 @@ resource limits; where no sandbox works the grader refuses unless --no-sandbox):
 2. then ik.check runs in the grader's own process on hidden cases (the instant check's kinds
    with numbers drawn from a seed at grading time, logged; --seed repeats a run), calling the
    functions the cells left in the shell's namespace through a pipe, each call under its time
-   limit (grading/remote.py). So nothing a notebook does to modules, builtins, stdout or
-   files changes a score. A graded name that is not a function written in the notebook gets 0
-   (grading/own_code.py). A check that ran past its time limit is run again in a fresh job
-   before the timeout counts (a busy machine, a first compile).
+   limit (grading/remote.py): limits in CPU seconds of the job, so a machine's load changes
+   no mark ("this machine is busy" where a call waited far longer than its limit). So nothing
+   a notebook does to modules, builtins, stdout or files changes a score. A graded name that
+   is not a function written in the notebook gets 0 (grading/own_code.py). A notebook whose
+   call the checks' time limit stopped is graded again from scratch, in a fresh sandbox,
+   before the timeout counts.
 The job sees a copy of ikteach in which the exercise's reference answers are stubs that raise,
 without the checker and the self-check (grading/reference.py: what the grader guarantees and
 what it only reports - code copied from ikteach, in grades.csv's `copied`). It is a fresh child
@@ -64,7 +66,8 @@ NOTEBOOK_TIMEOUT = 120.0  # seconds for all of a student's cells
 GRADE_TIMEOUT = 180.0     # seconds for a notebook's checks: every call
 GRACE = 15.0              # the fork server's kill comes first; then the grader ends it all
 MAX_NOTEBOOKS = 3 * 7      # notebooks graded per student (the rest: a note)
-TIMED_OUT = "did not return within"  # the checks' words for a call past its time limit
+RERUN = ("a check ran past its time limit and was run again in a fresh sandbox: the marks "
+         "are the second run's")
 INSTRUCTOR = Path(__file__).resolve().parents[2] / "instructor"  # the solutions: hidden
 
 __all__ = ["grade_all", "grade_notebook", "grade_book", "exercise_number", "main",
@@ -152,29 +155,35 @@ def _copied(number, held):
 
 
 def _run(number, book, sandbox, timeout, grade_timeout, seed=None):
-    """(verdict or None, notes, copied): the notebook's cells and then ik.check's calls in one
-    job (grading/cells.py), the verdict computed in this process on the hidden cases drawn
-    from `seed`; notes: the cells' errors and what went wrong on the way."""
+    """(verdict or None, notes, copied, stopped): the notebook's cells and then ik.check's
+    calls in one job (grading/cells.py), the verdict computed in this process on the hidden
+    cases drawn from `seed`, each call's limit counting the job's CPU seconds; notes: the
+    cells' errors and what went wrong on the way; stopped: a time limit of the checks ended a
+    call."""
     from . import check
+    from .check.verdicts import CPU_CLOCK
     from .grading.extract import code_cells
     from .grading.remote import ProcessEnded, Worker
 
     module = check.EXERCISES[number]
     worker = Worker(code_cells(book), sandbox, exercise=number, graded=module.FUNCTIONS,
                     limit=grade_timeout, timeout=timeout)
+    clock = CPU_CLOCK.set(worker.cpu_seconds)
     try:
         try:
             worker.start()
         except (ProcessEnded, ValueError) as exc:  # died, hung, or answered garbage
-            return None, worker.errors + (worker.notes or [f"nothing could be graded: {exc}"]), []
+            return (None, worker.errors + (worker.notes or [f"nothing could be graded: {exc}"]),
+                    [], False)
         notes = worker.errors + worker.notes
         copied = _copied(number, worker.held)
         if worker.foreign:  # a graded name bound to ikteach's (or anyone's) code: no marks
             return (check.registry.refuse(number, " ".join(worker.foreign.values())), notes,
-                    copied)
+                    copied, False)
         namespace = {name: worker.function(name) for name in worker.names}
-        return check.grade(number, namespace, seed=seed), notes, copied
+        return check.grade(number, namespace, seed=seed), notes, copied, worker.stopped
     finally:
+        CPU_CLOCK.reset(clock)
         worker.end()
 
 
@@ -189,9 +198,9 @@ def grade_book(name, book, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT
     one - never the instant check's public cases); returns a dict: file, exercise, how (how the
     exercise was recognised), score, max, status, message, notes (what went wrong on the way),
     answer (the written answer, if any), copied (functions whose code is ikteach's answer: for
-    the instructor), seed. A check that ran past its time limit is run once more, in a fresh
-    job, before the timeout costs marks (the first run may have been slowed by a busy machine
-    or by compiling the check)."""
+    the instructor), seed. A notebook whose call the checks' time limit stopped is run once
+    more, in a fresh sandbox, before the timeout costs marks."""
+    from .grading import servers
     from .grading.sandbox import Sandbox
 
     sandbox = sandbox or Sandbox()  # raises SandboxUnavailable where there is none
@@ -206,14 +215,13 @@ def grade_book(name, book, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT
     started = time.monotonic()
     try:
         result["answer"] = _answer_text(book)
-        verdict, notes, result["copied"] = _run(number, book, sandbox, timeout, grade_timeout,
-                                                seed)
-        if verdict is not None and TIMED_OUT in verdict.message:  # confirmed before it counts
-            again, notes_again, _ = _run(number, book, sandbox, timeout, grade_timeout, seed)
+        verdict, notes, result["copied"], stopped = _run(number, book, sandbox, timeout,
+                                                         grade_timeout, seed)
+        if stopped:  # the grader's own time limit: confirmed, from a clean start, before it counts
+            servers.close_all()
+            again, notes_again, _, _ = _run(number, book, sandbox, timeout, grade_timeout, seed)
             if again is not None:
-                verdict, notes = again, notes_again + [
-                    "a check ran past its time limit and was run again in a fresh process: "
-                    "the marks are the second run's"]
+                verdict, notes = again, notes_again + [RERUN]
         result["notes"] = notes[:40]
         if verdict is None:
             result["message"] = "no grade: your code could not be loaded for the checks"

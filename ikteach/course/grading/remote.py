@@ -195,6 +195,7 @@ class Worker:
         self.limit, self.timeout, self.deadline = limit, timeout, None
         self.process, self.names, self.errors, self.notes = None, [], [], []
         self.foreign, self.held, self._buffer = {}, {}, b""
+        self.stopped, self._cpu = False, 0.0  # stopped: a call the checks' time limit ended
 
     def start(self):
         """Run the cells; raises ProcessEnded when the job did not get to its checks (the notes
@@ -281,7 +282,8 @@ class Worker:
         try:                                    # (a JAX tracer) leaves the worker running
             self._write(request)
             reply = self._read(CALL_LIMIT)
-        except BaseException:  # a time limit, or a broken worker: end it, it may be busy
+        except BaseException as exc:  # a time limit, or a broken worker: end it, it may be busy
+            self.stopped = self.stopped or not isinstance(exc, Exception)
             self.end()
             raise
         if not isinstance(reply, dict):
@@ -298,6 +300,12 @@ class Worker:
             str(raised.get("message", "")))
         error.student_line = str(raised.get("line", ""))[:300]
         raise error
+
+    def cpu_seconds(self):
+        """CPU seconds the job's sandbox has used so far (what the checks' limits count)."""
+        if self.process is not None:
+            self._cpu = self.process.server.process.cpu_seconds()
+        return self._cpu
 
     def function(self, name):
         return functools.wraps(_handle_doc)(lambda *args: self.call(name, args))
