@@ -244,6 +244,42 @@ def test_a_call_held_up_without_using_its_cpu_time_says_the_machine_is_busy(monk
     assert verdict.score == 0 and "this machine is busy (or your code waits)" in verdict.message
 
 
+FIRST_RUN = """\
+import os
+try:  # what a first run of this notebook left: an extended attribute on /tmp, a file in it
+    _again = os.getxattr("/tmp", "user.ikteach-run") == b"1"
+except OSError:
+    _again = False
+_again = _again or os.path.exists("/tmp/ikteach-run")
+if not _again:
+    open("/tmp/ikteach-run", "w").close()
+    try:
+        os.setxattr("/tmp", "user.ikteach-run", b"1")
+    except OSError:
+        pass
+
+
+def jt_step(J, e):
+    if not _again:
+        while True:  # past the time limit, so that the grader runs the notebook again
+            pass
+""" + JT
+ASKS_AGAIN = "def jt_step(J, e):\n    raise RuntimeError('did not return within 5 s')\n"
+
+
+@pytest.mark.skipif(not SANDBOXED, reason="a fresh sandbox is what the re-run starts in")
+def test_a_run_again_comes_only_from_the_grader_s_time_limit_and_starts_clean(sandbox,
+                                                                                 monkeypatch):
+    """Re-runs (issue 50 item 4): a student's error in the time limit's words starts none; a
+    re-run finds nothing the first run left (files, extended attributes)."""
+    monkeypatch.setattr(check.verdicts, "TIME_LIMIT", 0.3)
+    asks = grade.grade_book("asks.ipynb", with_answer(ASKS_AGAIN), 60, 120, sandbox, seed=1)
+    assert asks["score"] == 0 and grade.RERUN not in asks["notes"], asks
+    again = grade.grade_book("again.ipynb", with_answer(FIRST_RUN), 60, 120, sandbox, seed=1)
+    assert again["score"] == 0 and grade.RERUN in again["notes"], again
+    assert "did not return within 0.3 s of CPU time" in again["message"], again
+
+
 def test_any_two_folders_get_two_rows_and_two_feedback_files():
     latin1 = os.fsdecode(b"M\xfcller")
     names = [latin1, "M\\xfcller", "Müller", "Mu\u0308ller", "Anna", "anna", "x" * 255]
