@@ -17,7 +17,7 @@ import pytest
 
 from ikteach.course import check, grade
 from ikteach.course.grading import report, servers
-from ikteach.course.grading.remote import Worker
+from ikteach.course.grading.remote import MAX_NOTES, ProcessEnded, Worker
 from ikteach.course.grading.sandbox import Sandbox
 from sandboxes import SANDBOXED
 
@@ -182,6 +182,28 @@ def test_what_a_job_says_is_bounded(sandbox):
     assert result["score"] == 0 and len(json.dumps(result)) < 40_000, len(json.dumps(result))
 
 
+FLOOD = """\
+import json, os, signal
+signal.signal(signal.SIGALRM, signal.SIG_IGN)  # the notebook's own alarm: ignored
+_lines = (json.dumps({"stopped": "x" * 20, "error": "y" * 400}) + "\\n").encode() * 200
+while True:
+    os.write(4, _lines)  # the job's replies pipe
+"""
+LOUD = "def jt_step(J, e):\n    raise RuntimeError('x' * 8_000_000)\n"
+
+
+def test_what_a_job_writes_during_its_cells_is_bounded_and_ends_at_the_deadline(sandbox):
+    """Issue 50 item 2: notes on arrival at most MAX_NOTES, the grader's deadline holds while
+    lines keep coming (the job is ended by the grader, not by its server's later limit), and a
+    student's 8 MB error message is cut."""
+    worker = Worker([(1, FLOOD)], sandbox, exercise=2, limit=120, timeout=1)
+    with pytest.raises(ProcessEnded, match="ignored the alarm"):
+        worker.start()
+    assert len(worker.errors) + len(worker.notes) <= MAX_NOTES + 1, len(worker.notes)
+    loud = grade.grade_book("loud.ipynb", with_answer(LOUD), 60, 120, sandbox, seed=1)
+    assert loud["score"] == 0 and len(json.dumps(loud)) < 10_000, len(json.dumps(loud))
+
+
 def _jobs():
     """The students' jobs of this process's sandboxes: children of a fork server (the same
     command line: a fork) that descend from this test."""
@@ -288,3 +310,21 @@ def test_any_two_folders_get_two_rows_and_two_feedback_files():
     files = {report.file_name(label).casefold() for label in shown.values()}
     assert len(files) == len(names), files
     assert shown["x" * 255] == "x" * 255 and shown[latin1].startswith("M\\xfcller [")
+
+
+def test_the_feedback_counts_the_notebook_the_csv_counts_and_names_the_others(tmp_path):
+    """Issue 50 item 3: the unfilled template and the answer as a browser's second download,
+    in either order: the CSV and the feedback both count the answer and name the template."""
+    def result(name, score, message):
+        return {"file": name, "exercise": 2, "how": "by its metadata", "score": score,
+                "max": 10.0, "status": "", "message": message, "notes": [], "answer": ""}
+
+    template = result("02_jt_step.ipynb", 0.0, "Exercise 2: not yet implemented")
+    answer = result("02_jt_step (1).ipynb", 10.0, "Exercise 2: passed, 10/10")
+    for order in ([answer, template], [template, answer]):
+        rows = report.write_results({"kim": order}, {"kim": []}, tmp_path / "g.csv",
+                                    tmp_path / "fb", "none")
+        page = (tmp_path / "fb" / "kim.txt").read_text()
+        assert rows[0]["ex2"] == 10.0 and "Total: 10/70" in page, page
+        assert "Exercise 2 (02_jt_step (1).ipynb): 10/10" in page, page
+        assert "not counted (the best notebook counts): 02_jt_step.ipynb: 0/10" in page, page

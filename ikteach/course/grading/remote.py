@@ -111,8 +111,8 @@ def decode(data, call=None):
             return fn
         return functools.partial(fn, *decode(data["args"]), **decode(data["kwargs"]))
     if "__opaque__" in data:
-        kind = type(str(data["__opaque__"]) or "object", (_Opaque,), {})
-        return kind(str(data.get("repr", "")))
+        kind = type(str(data["__opaque__"])[:60] or "object", (_Opaque,), {})
+        return kind(str(data.get("repr", ""))[:80])
     return {}
 
 
@@ -220,9 +220,10 @@ class Worker:
                     continue
                 if "ready" in message:
                     break
-                if "error" in message and len(self.errors) < MAX_NOTES:
+                full = len(self.errors) + len(self.notes) >= MAX_NOTES  # bounded on arrival
+                if "error" in message and not full:
                     self.errors.append(str(message["error"])[:400])
-                if "stopped" in message:
+                if "stopped" in message and not full:
                     self.notes.append(f"cell {str(message['stopped'])[:20]} did not finish "
                                       "within the notebook's time limit "
                                       f"({self.timeout:g} s): it was stopped there")
@@ -247,9 +248,9 @@ class Worker:
         """The job's next message (one JSON line), waiting at most `timeout` s and never past
         the deadline (of the cells or of the checks: `during`)."""
         fd = self.process.fileno()
-        while b"\n" not in self._buffer:
+        while b"\n" not in self._buffer or self.deadline < time.monotonic():
             left = self.deadline - time.monotonic()
-            ready, _, _ = select.select([fd], [], [], max(0.0, min(timeout, left)))
+            ready = left > 0 and select.select([fd], [], [], min(max(timeout, 0.0), left))[0]
             if not ready:
                 if left <= timeout and during == "cells":
                     raise ProcessEnded("it did not finish within the notebook's time limit "
@@ -293,11 +294,11 @@ class Worker:
             return decode(reply["value"], call=self.call)
         raised = reply.get("raise") if isinstance(reply.get("raise"), dict) else {}
         if raised.get("kind") == "stop":
-            raise StopSolve(raised.get("message", ""))
+            raise StopSolve(str(raised.get("message", ""))[:200])
         if raised.get("kind") == "not yet":
             raise NotImplementedError
-        error = type(str(raised.get("type", "Error")) or "Error", (Exception,), {})(
-            str(raised.get("message", "")))
+        error = type(str(raised.get("type", "Error"))[:80] or "Error", (Exception,), {})(
+            str(raised.get("message", ""))[:300])
         error.student_line = str(raised.get("line", ""))[:300]
         raise error
 

@@ -53,7 +53,7 @@ def file_name(label):
 
 def _feedback_text(student, results):
     lines = [f"Feedback for {student}", ""]
-    by_number = {r["exercise"]: r for r in results if r["exercise"] is not None}
+    by_number = _best(results)  # the CSV's choice
     for number in EXERCISE_NUMBERS:
         r = by_number.get(number)
         if r is None:
@@ -62,6 +62,9 @@ def _feedback_text(student, results):
         how = (f", taken as exercise {number} {r['how']}"
                if r.get("how") not in (None, "by its metadata") else "")
         lines.append(f"Exercise {number} ({r['file']}{how}): {r['score']:g}/{r['max']:g}")
+        lines += [f"  not counted (the best notebook counts): {o['file']}: {o['score']:g}/"
+                  f"{o['max']:g} - {o['message'].splitlines()[0][:200] if o['message'] else ''}"
+                  for o in results if o["exercise"] == number and o is not r]
         for line in r["message"].splitlines():
             lines.append(f"  {line}")
         for note in r["notes"]:
