@@ -103,6 +103,11 @@ def test_a_notebook_is_taken_for_its_exercise_by_metadata_content_or_name():
     assert grade.identify("2024_hw_03_pinv_step (1).ipynb", {"cells": []})[0] == 3
     assert grade.identify("x.ipynb", without_metadata(SOLUTION))[0] == 2
     assert grade.identify("01_jacobian.ipynb", SOLUTION) == (2, "by its metadata")
+    # exercise 3 answered in a copy of the exercise 2 file: its content decides (round 5)
+    started_from_2 = json.loads((ROOT / "instructor" / "solutions" / "03_pinv_step.ipynb").read_text())
+    started_from_2["metadata"] = SOLUTION["metadata"]
+    assert grade.identify("02_jt_step.ipynb", started_from_2) == (
+        3, "by its content (it defines `pinv_step`); its metadata says exercise 2")
     assert grade.identify("notes.ipynb", {"cells": [{"cell_type": "code",
                                                      "source": "print(1)"}]}) == (None, None)
 
@@ -307,6 +312,8 @@ def test_any_two_folders_get_two_rows_and_two_feedback_files():
     names = [latin1, "M\\xfcller", "Müller", "Mu\u0308ller", "Anna", "anna", "x" * 255]
     shown = report.labels(names)
     assert len(set(shown.values())) == len(names), shown
+    forged = names + [shown["Anna"], shown["Anna"] + " [0]"]  # folders named as hashed labels
+    assert len(set(report.labels(forged).values())) == len(forged), report.labels(forged)
     files = {report.file_name(label).casefold() for label in shown.values()}
     assert len(files) == len(names), files
     assert shown["x" * 255] == "x" * 255 and shown[latin1].startswith("M\\xfcller [")

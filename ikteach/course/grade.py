@@ -7,8 +7,9 @@
     python -m ikteach.course.grade --gradescope OUT.zip      (a Gradescope autograder bundle)
 
 SUBMISSIONS_DIR holds one folder per student (the folder name is the student), each with that
-student's exercise notebooks. A notebook is taken for an exercise by its metadata, else its
-content (the functions it defines, the check it calls), else an NN_ in its name (identify()).
+student's exercise notebooks. A notebook is taken for an exercise by its content (the
+functions it defines, the check it calls), else its metadata, else an NN_ in its name
+(identify()).
 Each notebook is one job, in a sandbox (ikteach.course.grading.sandbox: bubblewrap, an
 unprivileged user without capabilities, no network, a read-only whitelist of the machine,
 resource limits; where no sandbox works the grader refuses unless --no-sandbox):
@@ -107,18 +108,19 @@ def _from_content(book):
 
 
 def identify(path, book):
-    """(exercise number or None, how it was recognised): the notebook's metadata
-    (ikteach.exercise), else its content (the functions it defines, the check it calls), else
-    an NN_ in its file name."""
+    """(exercise number or None, how it was recognised): its content (the functions it
+    defines, the check it calls), else the notebook's metadata (ikteach.exercise: a student
+    who started exercise 3 from the exercise 2 file keeps exercise 2's), else an NN_ in its
+    file name."""
     meta = book.get("metadata") if isinstance(book, dict) else None
     meta = meta.get("ikteach") if isinstance(meta, dict) else None
-    number = meta.get("exercise") if isinstance(meta, dict) else None
-    if isinstance(number, int) and number in EXERCISE_NUMBERS:
-        return number, "by its metadata"
-    if isinstance(book, dict):
-        number, why = _from_content(book)
-        if number is not None:
-            return number, why
+    said = meta.get("exercise") if isinstance(meta, dict) else None
+    said = said if isinstance(said, int) and said in EXERCISE_NUMBERS else None
+    number, why = _from_content(book) if isinstance(book, dict) else (None, None)
+    if number is not None and number != said:
+        return number, why + (f"; its metadata says exercise {said}" if said else "")
+    if said is not None:
+        return said, "by its metadata"
     number = _from_name(path)
     return (number, "by its file name") if number is not None else (None, None)
 

@@ -30,14 +30,20 @@ def labels(students):
     another folder has the same NFC (then the raw name with every non-ASCII character escaped,
     so that the rows differ visibly); names that still look alike (a folder literally named
     `M\\xfcller` beside one whose name is the Latin-1 bytes) or differ only in case (one
-    feedback file on macOS or Windows) get a short hash of the folder's own bytes."""
+    feedback file on macOS or Windows) get a short hash of the folder's own bytes, again while
+    any two still clash (a folder named as another's hashed label)."""
     shown = {s: unicodedata.normalize("NFC", text(s)) for s in students}
     clashes = {n for n in shown.values() if list(shown.values()).count(n) > 1}
     shown = {s: (text(s).encode("ascii", "backslashreplace").decode() if n in clashes else n)
              for s, n in shown.items()}
-    folded = [n.casefold() for n in shown.values()]
-    return {s: (f"{n} [{hashlib.sha256(os.fsencode(s)).hexdigest()[:8]}]"
-                if folded.count(n.casefold()) > 1 else n) for s, n in shown.items()}
+    digits = 8
+    while True:  # until unique: a folder may be named as another's hashed label
+        folded = [n.casefold() for n in shown.values()]
+        if len(set(folded)) == len(folded):
+            return shown
+        shown = {s: (f"{n} [{hashlib.sha256(os.fsencode(s)).hexdigest()[:digits]}]"
+                     if folded.count(n.casefold()) > 1 else n) for s, n in shown.items()}
+        digits = 64  # the whole hash from the second round: no crafted clash of 8 digits
 
 
 def file_name(label):
