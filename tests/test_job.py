@@ -170,6 +170,34 @@ def test_a_job_that_changes_its_fork_server_does_not_reach_the_next(sandbox):
     assert after["score"] == 10 and after["notes"] == [], after
 
 
+LEAVE_METADATA = """\
+import os, struct
+_none = struct.pack("<I", 2) + b"".join(struct.pack("<HHI", tag, 0, 0xFFFFFFFF) for tag in (1, 4, 32))
+for _path, _name, _value in [("/tmp", "user.left", b"1"), ("/dev/shm", "user.left", b"1"),
+                             ("..", "system.posix_acl_default", _none), ("..", "user.left", b"1")]:
+    os.setxattr(_path, _name, _value)  # the server's folder (the job folder's parent) too
+"""
+SEES_METADATA = "import os\nassert not os.listxattr('/tmp') and not os.listxattr('/dev/shm')\n"
+
+
+@pytest.mark.skipif(not SANDBOXED, reason="only the sandbox stops it (the refusal is tested)")
+def test_extended_attributes_and_acls_a_job_leaves_do_not_reach_the_next(sandbox):
+    """Round 5: a default ACL without rights on the fork server's folder and xattrs on /tmp and
+    /dev/shm: the server is replaced, and the next notebook sees none of it."""
+    first = servers.server_for(sandbox, 2)
+    attacked = copy.deepcopy(SOLUTION)
+    attacked["cells"].insert(1, {"cell_type": "code", "metadata": {}, "outputs": [],
+                                 "execution_count": None, "source": LEAVE_METADATA})
+    left = grade.grade_book("attack.ipynb", attacked, 60, 120, sandbox, seed=1)
+    assert left["notes"] == [], left  # it did set them all
+    assert servers.server_for(sandbox, 2) is not first
+    honest = copy.deepcopy(SOLUTION)
+    honest["cells"].insert(1, {"cell_type": "code", "metadata": {}, "outputs": [],
+                               "execution_count": None, "source": SEES_METADATA})
+    after = grade.grade_book("b.ipynb", honest, 60, 120, sandbox, seed=1)
+    assert after["score"] == 10 and after["notes"] == [], after
+
+
 FORGED = """\
 import json, os
 _forged = {"ready": ["x%d" % i for i in range(100000)],

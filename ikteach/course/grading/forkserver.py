@@ -15,7 +15,8 @@ job pipes; everything else the server holds is closed in it. When the child ends
 grader says so, or its time limit passes) the server, as PID 1, kills every other process of
 the namespace (kill(-1): daemons, setsid, fork storms), reaps them, removes the job's folder,
 whatever appeared in the sandbox's writable /tmp and /dev, and SysV IPC objects; if anything
-there that existed before was changed (a /dev node replaced, /tmp's mode), or its own limits,
+there that existed before was changed (a /dev node replaced, /tmp's mode, an extended attribute
+or ACL there or on the server's folder), or its own limits,
 priority, CPU set or OOM score are not those it started with (a job may `prlimit` its server:
 same uid), it says `dirty` and the grader starts a fresh server: every job starts with the
 limits the grader set from outside. In the sandbox a job's child may write only beneath its
@@ -71,9 +72,18 @@ def _prctl(libc, option, value):
         libc.prctl(option, value, 0, 0, 0)
 
 
+def _xattrs(path):
+    """A path's extended attributes, POSIX ACLs included (they are xattrs)."""
+    try:
+        return tuple(sorted((name, os.getxattr(path, name, follow_symlinks=False))
+                            for name in os.listxattr(path, follow_symlinks=False)))
+    except (OSError, AttributeError):  # no xattrs here (a file system, or not Linux)
+        return ()
+
+
 def _state(roots, keep):
-    """{path: (mode, uid, inode)} of everything under `roots` (not following links), except
-    what lies inside `keep` (the server's own folder)."""
+    """{path: (mode, uid, inode, xattrs)} of everything under `roots` (not following links),
+    except what lies inside `keep` (the server's own folder)."""
     seen = {}
     for root in roots:
         for folder, dirs, files in os.walk(root):
@@ -84,9 +94,9 @@ def _state(roots, keep):
                     st = os.lstat(path)
                 except OSError:
                     continue
-                seen[path] = (st.st_mode, st.st_uid, st.st_ino)
+                seen[path] = (st.st_mode, st.st_uid, st.st_ino, _xattrs(path))
     st = os.lstat(keep)
-    seen[keep] = (st.st_mode, st.st_uid, st.st_ino)
+    seen[keep] = (st.st_mode, st.st_uid, st.st_ino, _xattrs(keep))
     return seen
 
 
