@@ -363,3 +363,14 @@ def test_the_feedback_counts_the_notebook_the_csv_counts_and_names_the_others(tm
         assert rows[0]["ex2"] == 10.0 and "Total: 10/70" in page, page
         assert "Exercise 2 (02_jt_step (1).ipynb): 10/10" in page, page
         assert "not counted (the best notebook counts): 02_jt_step.ipynb: 0/10" in page, page
+
+
+def test_a_student_s_notebooks_are_never_graded_at_once():
+    """Round 5 (a relay through the page cache between two of one student's notebooks under
+    --jobs 2): each student's notebooks are in one grading process's share, in order."""
+    jobs_list = [(s, f"{s}/{n:02d}.ipynb", None) for n in (1, 2, 5) for s in ("ann", "bo", "cy")]
+    shares = grade.by_student(jobs_list, 2)
+    assert sorted(job for share in shares for job in share) == sorted(jobs_list)
+    for student in ("ann", "bo", "cy"):
+        assert sum(any(job[0] == student for job in share) for share in shares) == 1
+    assert all(share == [job for job in jobs_list if job in share] for share in shares)

@@ -255,23 +255,38 @@ def grade_notebook(path, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT, 
         return _result(path.name, number, f"could not grade the notebook: {type(exc).__name__}")
 
 
+def by_student(jobs_list, jobs):
+    """jobs_list in `jobs` shares, each student's notebooks in one share (graded one after
+    another: a student's notebooks never run at once, so none reaches another exercise's
+    reference through what they share, e.g. the page cache)."""
+    students = sorted({student for student, _, _ in jobs_list}, key=repr)
+    share = {student: i % jobs for i, student in enumerate(students)}
+    return [[job for job in jobs_list if share[job[0]] == n] for n in range(jobs)]
+
+
+def _grade_share(share, timeout, grade_timeout, sandbox, seed):
+    return [grade_notebook(nb, timeout, grade_timeout, sandbox, problem, seed)
+            for _, nb, problem in share]
+
+
 def _grade_jobs(jobs_list, jobs, timeout, grade_timeout, sandbox, seed):
-    """Every notebook's result, in order; a worker that dies costs only its notebooks."""
+    """Every notebook's result, in order; a grading process that dies costs its share."""
     if jobs <= 1:
-        return [grade_notebook(nb, timeout, grade_timeout, sandbox, problem, seed)
-                for _, nb, problem in jobs_list]
+        return _grade_share(jobs_list, timeout, grade_timeout, sandbox, seed)
+    shares = [s for s in by_student(jobs_list, jobs) if s]
     with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
-        futures = [pool.submit(grade_notebook, nb, timeout, grade_timeout, sandbox, problem,
-                               seed)
-                   for _, nb, problem in jobs_list]
-        outcomes = []
-        for (_, nb, _), future in zip(jobs_list, futures):
+        futures = [pool.submit(_grade_share, share, timeout, grade_timeout, sandbox, seed)
+                   for share in shares]
+        outcomes = {}
+        for share, future in zip(shares, futures):
             try:
-                outcomes.append(future.result())
+                results = future.result()
             except Exception as exc:  # noqa: BLE001 - a crashed grading process
-                outcomes.append(_result(os.path.basename(nb), None, "could not grade the "
-                                        f"notebook: the grading process failed ({exc!r:.200})"))
-    return outcomes
+                results = [_result(os.path.basename(nb), None, "could not grade the notebook: "
+                                   f"the grading process failed ({exc!r:.200})")
+                           for _, nb, _ in share]
+            outcomes.update({id(job): r for job, r in zip(share, results)})
+    return [outcomes[id(job)] for job in jobs_list]
 
 
 def grade_all(submissions, out, feedback=None, timeout=NOTEBOOK_TIMEOUT, jobs=1,
