@@ -161,6 +161,8 @@ def test_solutions_get_full_marks(graded):
     rows, feedback = graded.rows, graded.feedback
     assert scores(rows["solutions"]) == ([10.0] * 7, 70.0)
     assert feedback["solutions"].count("passed, 10/10") == 7
+    # not reported as ikteach's own answer (the reference rule's `copied`)
+    assert rows["solutions"]["copied"] == "" and "for the instructor" not in feedback["solutions"]
     # exercise 6's written answer is copied for the instructor, not marked
     assert "your written answer (not marked by the checker" in feedback["solutions"]
     assert "| Stretched towards a target it cannot reach" in feedback["solutions"]
@@ -390,8 +392,9 @@ def test_a_failing_self_check_stops_before_grading_anyone(tmp_path, monkeypatch,
     else:  # the cells report an error, as when the sandbox cannot run them
         run = grade._run
         monkeypatch.setattr(grade, "_run", lambda *args, **kwargs: (
-            lambda verdict, notes, copied: (verdict, notes + ["cell 1 raised ImportError"],
-                                            copied))(*run(*args, **kwargs)))
+            lambda verdict, notes, copied, stopped: (
+                verdict, notes + ["cell 1 raised ImportError"], copied, stopped))(
+                    *run(*args, **kwargs)))
         why = "a correct jt_step (exercise 2) got 10/10 (expected 10/10, without notes)"
     subs, out = one_student(tmp_path)
     flags = [] if SANDBOXED else ["--no-sandbox"]

@@ -3,8 +3,8 @@ answer" that the grader can stop scores nothing, because the sandbox of the grad
 holds that answer only as a stub (grading/reference.py); the answers a notebook carries in
 itself (a marshalled blob, source typed in) are reported in grades.csv's `copied` column and
 the feedback, for the instructor; a lookup table of the instant check's cases meets hidden
-cases. Beside them an honest student (the instructor's solutions) keeps 70/70, and the class
-gets its grades.csv. Without bubblewrap the same run is made with --no-sandbox (the copy of
+cases. The class gets its grades.csv (that the instructor's solutions keep 70/70 and are not
+reported, beside hostile students, is tests/test_grade.py's). Without bubblewrap the same run is made with --no-sandbox (the copy of
 ikteach is then what PYTHONPATH points at)."""
 import base64
 import csv
@@ -212,7 +212,6 @@ def write_student(subs, student, number, source):
 def graded(tmp_path_factory):
     base = tmp_path_factory.mktemp("reference-rule")
     subs = base / "submissions"
-    shutil.copytree(SOLUTIONS, subs / "honest")
     sources = {"marshal_blob": marshal_blob(), "typed_in": by_hand(),
                "lookup_table": lookup_table(), "fingerprint_stall": fingerprint_stall()}
     for student, number, source, *_ in SPELLINGS:
@@ -226,13 +225,6 @@ def graded(tmp_path_factory):
     rows = {r["student"]: r for r in csv.DictReader(out.open(encoding="utf-8"))}
     feedback = {p.stem: p.read_text(encoding="utf-8") for p in (base / "out" / "feedback").glob("*.txt")}
     return rows, feedback, run.stdout
-
-
-def test_the_honest_student_keeps_full_marks_and_is_not_reported(graded):
-    rows, feedback, _ = graded
-    assert [float(rows["honest"][f"ex{n}"]) for n in check.NUMBERS] == [10.0] * 7
-    assert float(rows["honest"]["total"]) == 70.0 and rows["honest"]["copied"] == ""
-    assert "for the instructor" not in feedback["honest"]
 
 
 @pytest.mark.parametrize("student, number, source, marks, line, copied", SPELLINGS)

@@ -59,8 +59,9 @@ def shell():
             try:
                 return super().run_line_magic(magic_name, line, _stack_depth + 1)
             except Exception as exc:
-                self.notes.append(f"`%{magic_name} {line}`"[:80] + " was skipped: "
-                                  + error_line("its", exc).removeprefix("cell its ")[:200])
+                why = str(exc).splitlines()[0][:200] if str(exc) else ""
+                self.notes.append(f"`%{magic_name} {line}`"[:80] + " was skipped "
+                                  f"({type(exc).__name__[:80]}: {why})")
 
         def system(self, cmd, mark="!"):
             self.notes.append(f"`{mark}{cmd}`"[:80] + " was skipped: the grader runs no shell "
