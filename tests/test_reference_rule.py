@@ -212,6 +212,7 @@ def write_student(subs, student, number, source):
 def graded(tmp_path_factory):
     base = tmp_path_factory.mktemp("reference-rule")
     subs = base / "submissions"
+    subs.mkdir()
     sources = {"marshal_blob": marshal_blob(), "typed_in": by_hand(),
                "lookup_table": lookup_table(), "fingerprint_stall": fingerprint_stall()}
     for student, number, source, *_ in SPELLINGS:

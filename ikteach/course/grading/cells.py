@@ -44,7 +44,6 @@ def shell():
     """IPython's shell, without history (no database, no thread); cells compile as <cell N>;
     `notes` collects the magics it skipped."""
     from IPython.core.interactiveshell import InteractiveShell
-    from IPython.utils.text import SList
     from traitlets.config import Config
 
     class Shell(InteractiveShell):
@@ -66,10 +65,6 @@ def shell():
         def system(self, cmd, mark="!"):
             self.notes.append(f"`{mark}{cmd}`"[:80] + " was skipped: the grader runs no shell "
                               "commands or installs")
-
-        def getoutput(self, cmd, split=True, depth=0):
-            self.system(cmd)
-            return SList()
 
     config = Config()
     config.HistoryManager.enabled = False
