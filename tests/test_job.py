@@ -374,3 +374,13 @@ def test_a_student_s_notebooks_are_never_graded_at_once():
     for student in ("ann", "bo", "cy"):
         assert sum(any(job[0] == student for job in share) for share in shares) == 1
     assert all(share == [job for job in jobs_list if job in share] for share in shares)
+
+
+def test_an_ordinary_user_without_a_cpu_share_grades_one_notebook_at_a_time():
+    """Issue 50 item 1: without a cpu cgroup per sandbox, a fork storm would take a concurrent
+    classmate's CPU: one notebook at a time, said in the log."""
+    from types import SimpleNamespace
+    assert grade.jobs_for(SimpleNamespace(controlled={"pids", "cpu"}), 2) == (2, None)
+    jobs, why = grade.jobs_for(SimpleNamespace(controlled={"pids"}), 2)
+    assert jobs == 1 and "no CPU share per sandbox" in why
+    assert grade.jobs_for(SimpleNamespace(controlled=set()), 1) == (1, None)

@@ -264,6 +264,16 @@ def by_student(jobs_list, jobs):
     return [[job for job in jobs_list if share[job[0]] == n] for n in range(jobs)]
 
 
+def jobs_for(sandbox, jobs):
+    """(notebooks graded at once, the log's line or None): one where this user may give no
+    sandbox its own CPU share (no cpu cgroup: an ordinary user without a delegated one), so a
+    student's busy processes never take a classmate's CPU."""
+    if jobs > 1 and "cpu" not in sandbox.controlled:
+        return 1, (f"--jobs {jobs}: graded one notebook at a time instead (no CPU share per "
+                   "sandbox here: a cpu cgroup this user may make, e.g. a delegated user scope)")
+    return jobs, None
+
+
 def _grade_share(share, timeout, grade_timeout, sandbox, seed):
     return [grade_notebook(nb, timeout, grade_timeout, sandbox, problem, seed)
             for _, nb, problem in share]
@@ -324,6 +334,9 @@ def grade_all(submissions, out, feedback=None, timeout=NOTEBOOK_TIMEOUT, jobs=1,
             log(f"  - {line}")
         seed = secrets.randbits(63) if seed is None else int(seed)
         log(f"hidden cases: seed {seed} (--seed {seed} grades on the same cases again)")
+        jobs, why = jobs_for(sandbox, limits.jobs)
+        if why:
+            log(why)
         selfcheck.run(functools.partial(grade_book, seed=seed), sandbox, timeout, grade_timeout)
         log("self-check: a known-good answer got 10/10 and a wrapper of ikteach's own got 0")
         for name in ignored:
