@@ -147,6 +147,10 @@ def planar_jacobian(lengths, theta):
 '''
 
 
+FORGE_FINGERPRINTS = ("import ikteach.course.grading.reference as _reference\n"
+                      "_reference.fingerprints = lambda codes: {}\n")
+
+
 def by_hand():
     """ikteach's pinv_step typed into the notebook, names changed: plagiarism, reported."""
     source = "".join(line for line in inspect.getsource(pinv.pinv_step.__wrapped__)
@@ -182,6 +186,9 @@ SPELLINGS = [
     ("marshal_blob", 3, None, 10, "has the same code as ikteach.core.pinv.pinv_step", True),
     ("typed_in", 3, None, 10, "`pinv_step` has the same code as ikteach.core.pinv.pinv_step",
      True),
+    # round 5: the job's own fingerprints replaced by a cell; the source's are computed apart
+    ("typed_in_forged", 3, None, 10, "`pinv_step` has the same code as ikteach.core.pinv.pinv_step",
+     True),
     ("lookup_table", 1, None, 2, "lever arms x", False),
     # the paths the instant check follows too (test_instant_check_agrees)
     ("import_inside", 2, IMPORT_INSIDE, 0, "`jt_step` raised ReferenceBlocked", False),
@@ -214,6 +221,7 @@ def graded(tmp_path_factory):
     subs = base / "submissions"
     subs.mkdir()
     sources = {"marshal_blob": marshal_blob(), "typed_in": by_hand(),
+               "typed_in_forged": FORGE_FINGERPRINTS + by_hand(),
                "lookup_table": lookup_table(), "fingerprint_stall": fingerprint_stall()}
     for student, number, source, *_ in SPELLINGS:
         write_student(subs, student, number, source or sources[student])

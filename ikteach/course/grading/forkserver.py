@@ -26,7 +26,8 @@ not dumpable (no ptrace, no /proc/1/mem) and, as init, ignores every signal from
 namespace that it has no handler for.
 
 Control messages (JSON over a SOCK_SEQPACKET socket, the job's pipes passed with SCM_RIGHTS):
-  -> {"job": id, "kind": "notebook"|"probe", "limit": s}  + fds (requests in, replies out)
+  -> {"job": id, "kind": "notebook"|"fingerprints"|"probe", "limit": s}  + fds (requests in,
+                                                            replies out)
   -> {"end": id}                                            the grader is done with the job
   <- {"done": id, "status": exit status or null, "timed_out": bool, "dirty": bool}
 """
@@ -295,6 +296,11 @@ def _child(kind, fds, job, control, sandboxed):
         if kind == "notebook":
             from ikteach.course.grading import cells
             cells.main(requests, replies)
+        elif kind == "fingerprints":  # of the cells' source, where no student code has run
+            from ikteach.course.grading import reference
+            cells = json.loads(os.fdopen(requests, encoding="utf-8", errors="replace").readline())
+            found = reference.source_fingerprints([(int(n), str(s)) for n, s in cells["cells"]])
+            os.write(replies, (json.dumps(found) + "\n").encode())
         elif kind == "probe":
             from ikteach.course.grading import probe
             probe.job(requests, replies)
