@@ -183,7 +183,9 @@ SPELLINGS = [
     ("selfcheck_answer", 2, SELFCHECK, 0, "`jt_step` not found in the notebook", False),
     ("marshal_at_run_time", 3, MARSHAL_AT_RUN_TIME, 0, "`pinv_step` raised ReferenceBlocked",
      False),
-    ("marshal_blob", 3, None, 10, "has the same code as ikteach.core.pinv.pinv_step", True),
+    # code loaded at run time is not what the notebook shows: the report (computed from the
+    # source, outside the student's process) does not see it; the marks are the answer's
+    ("marshal_blob", 3, None, 10, "passed, 10/10", False),
     ("typed_in", 3, None, 10, "`pinv_step` has the same code as ikteach.core.pinv.pinv_step",
      True),
     # round 5: the job's own fingerprints replaced by a cell; the source's are computed apart

@@ -146,10 +146,9 @@ def _answer_text(book):
 
 def _copied(number, held):
     """Lines for the instructor: the notebook's functions whose code is exercise `number`'s
-    reference (`held`: the fingerprints of the code the notebook's namespace holds, from its
-    job, and of the code its cells' source defines, from a job no student code ran in:
-    nothing of a student's code is compiled here). Reported, never scored
-    (grading/reference.py)."""
+    reference (`held`: the fingerprints of the code its cells' source defines, computed in a
+    job where no student code has run: nothing of a student's code is compiled here, nothing
+    is taken from the student's process). Reported, never scored (grading/reference.py)."""
     from . import check
     from .grading import reference
 
@@ -173,14 +172,14 @@ def _run(number, book, sandbox, timeout, grade_timeout, seed=None):
                     limit=grade_timeout, timeout=timeout)
     clock = CPU_CLOCK.set(worker.cpu_seconds)
     try:
-        source_held = worker.source_held()  # first: a server runs one job at a time
+        held = worker.held()  # before the notebook's job: a server runs one at a time
         try:
             worker.start()
         except (ProcessEnded, ValueError) as exc:  # died, hung, or answered garbage
             return (None, worker.errors + (worker.notes or [f"nothing could be graded: {exc}"]),
                     [], False)
         notes = worker.errors + worker.notes
-        copied = _copied(number, {**worker.held, **source_held})
+        copied = _copied(number, held)
         if worker.foreign:  # a graded name bound to ikteach's (or anyone's) code: no marks
             return (check.registry.refuse(number, " ".join(worker.foreign.values())), notes,
                     copied, False)

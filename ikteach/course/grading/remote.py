@@ -14,7 +14,6 @@ import importlib
 import json
 import os
 import select
-import signal
 import time
 import traceback
 
@@ -23,7 +22,7 @@ CALL_LIMIT = 600.0       # last-resort limit on one reply (the checks' own limit
 MAX_REPLY = 64 << 20     # bytes
 MAX_NOTES, MAX_NAMES, MAX_HELD = 30, 200, 200
 GRACE = 15.0             # seconds past the cells' own alarm before the job is killed
-HELD_LIMIT = 5.0         # seconds for the fingerprints of the code a notebook holds
+HELD_LIMIT = 5.0         # seconds for the fingerprints of the code a notebook's source defines
 
 
 class ProcessEnded(Exception):
@@ -130,32 +129,16 @@ def _student_line(exc):
     return ""
 
 
-class _TimeUp(BaseException):
-    pass
-
-
-def _time_up(signum, frame):
-    raise _TimeUp()
-
-
 def serve(namespace, graded, requests, send):
     """After the cells (cells.py): say what the namespace holds, then answer calls, one JSON
     line each, until the grader closes the requests."""
     from ikteach.core.solve import StopSolve
-    from ikteach.course.grading import own_code, reference
+    from ikteach.course.grading import own_code
 
-    signal.signal(signal.SIGALRM, _time_up)
-    signal.setitimer(signal.ITIMER_REAL, HELD_LIMIT)
-    try:  # reported, not trusted; under its own limit (a cell crafted to make it slow)
-        held = reference.fingerprints(reference.held_code(namespace))
-    except _TimeUp:
-        held = {}
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
     callables = sorted(k for k, v in namespace.items() if callable(v) and k[:2] != "__")
     first = [k for k in graded if k in callables]  # the grader keeps MAX_NAMES: graded ones first
     send({"ready": first + [k for k in callables if k not in first],
-          "foreign": own_code.foreign(namespace, graded), "held": held})
+          "foreign": own_code.foreign(namespace, graded)})
     handles = []
     for line in requests:
         request = json.loads(line)
@@ -185,7 +168,7 @@ class Worker:
     grades; `limit`: seconds for the checks (every call), applied from outside the student's
     process: it is then killed, whatever it does with its signals. After start(): errors
     (cells that raised), notes (what went wrong on the way), names, foreign (graded names not
-    written in the notebook), held ({fingerprint: function name} of the code it holds)."""
+    written in the notebook)."""
 
     def __init__(self, cells, sandbox, exercise=None, graded=(), limit=CALL_LIMIT,
                  timeout=STARTUP_LIMIT):
@@ -194,7 +177,7 @@ class Worker:
         self.setup = {"cells": cells, "graded": self.graded, "timeout": float(timeout)}
         self.limit, self.timeout, self.deadline = limit, timeout, None
         self.process, self.names, self.errors, self.notes = None, [], [], []
-        self.foreign, self.held, self._buffer = {}, {}, b""
+        self.foreign, self._buffer = {}, b""
         self.stopped, self._cpu = False, 0.0  # stopped: a call the checks' time limit ended
 
     def start(self):
@@ -236,9 +219,6 @@ class Worker:
         foreign = message.get("foreign", {})
         self.foreign = {k: str(v)[:400] for k, v in foreign.items()
                         if k in self.graded} if isinstance(foreign, dict) else {}
-        held = message.get("held", {})
-        self.held = {str(k)[:64]: str(v)[:80] for k, v in list(held.items())[:MAX_HELD]} \
-            if isinstance(held, dict) else {}
         return self
 
     def _write(self, message):
@@ -302,10 +282,10 @@ class Worker:
         error.student_line = str(raised.get("line", ""))[:300]
         raise error
 
-    def source_held(self):
+    def held(self):
         """{fingerprint: function name} of the code the cells' source defines, computed in a job
-        of its own, where no student code has run (`held`, from the notebook's job, could be
-        forged by its cells); {} where that job fails."""
+        of its own, where no student code has run (the notebook's own job could forge it); {}
+        where that job fails. Call it before start(): a fork server runs one job at a time."""
         from .servers import server_for
 
         job = server_for(self.sandbox, self.exercise).job(
