@@ -48,6 +48,7 @@ per student (FEEDBACK/<student>.txt, by default a `feedback` folder next to the 
 starts with what the sandbox enforces and what it cannot on this machine.
 """
 import argparse
+import collections
 import dataclasses
 import functools
 import os
@@ -260,8 +261,11 @@ def by_student(jobs_list, jobs):
     """jobs_list in `jobs` shares, each student's notebooks in one share (graded one after
     another: a student's notebooks never run at once, so none reaches another exercise's
     reference through what they share, e.g. the page cache)."""
-    students = sorted({student for student, _, _ in jobs_list}, key=repr)
-    share = {student: i % jobs for i, student in enumerate(students)}
+    counts = collections.Counter(student for student, _, _ in jobs_list)
+    sizes, share = [0] * jobs, {}
+    for student, count in sorted(counts.items(), key=lambda c: (-c[1], repr(c[0]))):
+        share[student] = sizes.index(min(sizes))  # the most notebooks first, to the emptiest
+        sizes[share[student]] += count
     return [[job for job in jobs_list if share[job[0]] == n] for n in range(jobs)]
 
 
