@@ -6,6 +6,7 @@ With bubblewrap (as root here and in CI) the job is in the sandbox; without it t
 --no-sandbox path runs the same job, and the tests of what only a sandbox stops are skipped
 (tests/test_grade.py checks the refusal there).
 """
+import contextlib
 import copy
 import json
 import os
@@ -260,13 +261,16 @@ def _jobs():
 
 def _busy(done):
     """A machine busier than any load: the students' jobs get 0.25 s to run in every 1.25 s."""
+    def send(pids, number):
+        for pid in pids:
+            with contextlib.suppress(ProcessLookupError):  # a job that has just ended
+                os.kill(pid, number)
+
     while not done.wait(0.25):
         frozen = _jobs()
-        for pid in frozen:
-            os.kill(pid, signal.SIGSTOP)
+        send(frozen, signal.SIGSTOP)
         done.wait(1.0)
-        for pid in frozen:
-            os.kill(pid, signal.SIGCONT)
+        send(frozen, signal.SIGCONT)
 
 
 def test_honest_answers_keep_their_marks_on_a_machine_too_busy_for_their_time_limits(
