@@ -161,6 +161,8 @@ def test_solutions_get_full_marks(graded):
     rows, feedback = graded.rows, graded.feedback
     assert scores(rows["solutions"]) == ([10.0] * 7, 70.0)
     assert feedback["solutions"].count("passed, 10/10") == 7
+    # not reported as ikteach's own answer (the reference rule's `copied`)
+    assert rows["solutions"]["copied"] == "" and "for the instructor" not in feedback["solutions"]
     # exercise 6's written answer is copied for the instructor, not marked
     assert "your written answer (not marked by the checker" in feedback["solutions"]
     assert "| Stretched towards a target it cannot reach" in feedback["solutions"]
@@ -282,8 +284,13 @@ def test_a_job_s_files_stay_within_its_tmpfs(graded):
     assert all(0 < mib <= TMPFS_MB for mib in written.values()), written
 
 
-def test_a_cell_magic_on_each_solution_still_gets_full_marks(graded):
-    assert scores(graded.rows["cell_magic"]) == ([10.0] * 7, 70.0)
+def test_magics_on_each_solution_still_get_full_marks(graded):
+    """%%time or `%matplotlib inline` opening each answer's cell, and a helper the answers call
+    from a cell opening with `%matplotlib inline` and a common line magic (issue 50): they run
+    as in a kernel, shell lines are skipped with a note, and nothing after them is lost."""
+    assert scores(graded.rows["cell_magic"]) == ([10.0] * 7, 70.0), graded.feedback["cell_magic"]
+    assert "`%pip install --quiet ikteach` was skipped" in graded.feedback["cell_magic"]
+    assert "raised" not in graded.feedback["cell_magic"]
 
 
 def test_any_name_gets_one_row_that_no_spreadsheet_runs(graded):
@@ -385,8 +392,9 @@ def test_a_failing_self_check_stops_before_grading_anyone(tmp_path, monkeypatch,
     else:  # the cells report an error, as when the sandbox cannot run them
         run = grade._run
         monkeypatch.setattr(grade, "_run", lambda *args, **kwargs: (
-            lambda verdict, notes, copied: (verdict, notes + ["cell 1 raised ImportError"],
-                                            copied))(*run(*args, **kwargs)))
+            lambda verdict, notes, copied, stopped: (
+                verdict, notes + ["cell 1 raised ImportError"], copied, stopped))(
+                    *run(*args, **kwargs)))
         why = "a correct jt_step (exercise 2) got 10/10 (expected 10/10, without notes)"
     subs, out = one_student(tmp_path)
     flags = [] if SANDBOXED else ["--no-sandbox"]

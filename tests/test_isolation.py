@@ -1,7 +1,8 @@
 """One student's CPU and time stay in that student's jobs (issue 35): a class of three graded
 two notebooks at a time - a CPU storm (200 busy children, each trying a session of its own,
-kept alive through the notebook's run and its checks), forty cells of shell escapes, and an
-honest classmate (the instructor's solutions) graded beside them, who keeps 70/70.
+kept alive through the notebook's run and its checks), forty cells of shell escapes (skipped),
+and an honest classmate graded beside them (the instructor's solutions to exercise 2, the
+storm's, and 5, a solve under a time limit), who keeps full marks.
 
 Where this machine has no sandbox the grader refuses the class (exit status 2, no CSV): the
 storm would run on the machine itself.
@@ -16,10 +17,18 @@ from pathlib import Path
 import pytest
 
 from ikteach.course import grade
+from ikteach.course.grading.remote import MAX_NOTES
 from sandboxes import SANDBOXED
 
 ROOT = Path(__file__).resolve().parents[1]
 CLASS = ROOT / "tests" / "submissions" / "storm_class"
+HONEST = ("02_jt_step.ipynb", "05_stop_rule.ipynb")  # the attacks' exercise, and a solve
+
+
+def honest(folder):
+    folder.mkdir(parents=True)
+    for name in HONEST:
+        shutil.copy(ROOT / "instructor" / "solutions" / name, folder / name)
 TIMEOUT, GRADE_TIMEOUT = 10, 40
 
 
@@ -28,7 +37,7 @@ def graded(tmp_path_factory):
     base = tmp_path_factory.mktemp("storm")
     subs = base / "submissions"
     shutil.copytree(CLASS, subs)
-    shutil.copytree(ROOT / "instructor" / "solutions", subs / "honest")
+    honest(subs / "honest")
     out = base / "out" / "grades.csv"
     run = subprocess.run([sys.executable, "-m", "ikteach.course.grade", str(subs), "--out",
                           str(out), "--timeout", str(TIMEOUT), "--grade-timeout",
@@ -50,20 +59,19 @@ def test_the_honest_classmate_keeps_full_marks_beside_a_cpu_storm(graded):
         return
     rows, feedback, _ = graded
     assert set(rows) == {"cpu_storm", "honest", "shell_escapes"}
-    assert [float(rows["honest"][f"ex{n}"]) for n in range(1, 8)] == [10.0] * 7, \
-        feedback["honest"]
+    assert float(rows["honest"]["total"]) == 10.0 * len(HONEST), feedback["honest"]
     assert "did not finish within the notebook's time limit" in feedback["cpu_storm"]
 
 
-def test_shell_escapes_hold_to_the_time_limits(graded):
-    """40 cells of 300 `!x` lines: the cells are stopped at --timeout, the checks (whose worker
-    reads the cells' IPython syntax) at --grade-timeout, and the grader's own process never
-    works on them: the notebook costs at most the two limits and the grace."""
+def test_shell_escapes_are_skipped_with_bounded_notes(graded):
+    """40 cells of 300 `!x` lines: the grader's shell runs no shell line (issue 50: skipped, a
+    note each, at most MAX_NOTES kept), the answer is graded, within the two limits."""
     if graded is None:
         return
     rows, feedback, log = graded
     text = feedback["shell_escapes"]
-    assert f"did not finish within the notebook's time limit ({TIMEOUT} s)" in text, text
+    assert "Exercise 2 (02_jt_step.ipynb): 10/10" in text and "`!x` was skipped" in text, text
+    assert text.count("was skipped") <= MAX_NOTES, text
     took = re.search(r"shell_escapes/02_jt_step.ipynb: .* \((\d+) s\)", log)
     assert int(took.group(1)) <= TIMEOUT + GRADE_TIMEOUT + grade.GRACE, log
 
@@ -126,7 +134,7 @@ def graded_as_user():
         pytest.skip(f"an ordinary user cannot read this Python ({sys.base_prefix})")
     base = Path(tempfile.mkdtemp(prefix="ikteach-as-user-"))  # pytest's folders are root's only
     subs = base / "submissions"
-    shutil.copytree(ROOT / "instructor" / "solutions", subs / "zz_honest")  # graded last
+    honest(subs / "zz_honest")  # graded last
     for name, source in (("fork_to_limit", FORK_TO_LIMIT), ("prlimit_server", PRLIMIT_SERVER),
                          ("forged", FORGED)):
         (subs / name).mkdir(parents=True)
@@ -152,6 +160,5 @@ def graded_as_user():
 def test_as_an_ordinary_user_the_classmate_keeps_full_marks(graded_as_user):
     rows, feedback, log = graded_as_user
     assert "at most 256 per sandbox (RLIMIT_NPROC in its user namespace" in log, log
-    assert [float(rows["zz_honest"][f"ex{n}"]) for n in range(1, 8)] == [10.0] * 7, \
-        feedback["zz_honest"]
+    assert float(rows["zz_honest"]["total"]) == 10.0 * len(HONEST), feedback["zz_honest"]
     assert float(rows["forged"]["total"]) == 0 and len(rows["forged"]["notes"]) < 2000

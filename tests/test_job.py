@@ -6,19 +6,19 @@ With bubblewrap (as root here and in CI) the job is in the sandbox; without it t
 --no-sandbox path runs the same job, and the tests of what only a sandbox stops are skipped
 (tests/test_grade.py checks the refusal there).
 """
+import contextlib
 import copy
 import json
-import multiprocessing
 import os
-import subprocess
-import sys
+import signal
+import threading
 from pathlib import Path
 
 import pytest
 
-from ikteach.course import grade
+from ikteach.course import check, grade
 from ikteach.course.grading import report, servers
-from ikteach.course.grading.remote import Worker
+from ikteach.course.grading.remote import MAX_NOTES, ProcessEnded, Worker
 from ikteach.course.grading.sandbox import Sandbox
 from sandboxes import SANDBOXED
 
@@ -104,6 +104,11 @@ def test_a_notebook_is_taken_for_its_exercise_by_metadata_content_or_name():
     assert grade.identify("2024_hw_03_pinv_step (1).ipynb", {"cells": []})[0] == 3
     assert grade.identify("x.ipynb", without_metadata(SOLUTION))[0] == 2
     assert grade.identify("01_jacobian.ipynb", SOLUTION) == (2, "by its metadata")
+    # exercise 3 answered in a copy of the exercise 2 file: its content decides (round 5)
+    started_from_2 = json.loads((ROOT / "instructor" / "solutions" / "03_pinv_step.ipynb").read_text())
+    started_from_2["metadata"] = SOLUTION["metadata"]
+    assert grade.identify("02_jt_step.ipynb", started_from_2) == (
+        3, "by its content (it defines `pinv_step`); its metadata says exercise 2")
     assert grade.identify("notes.ipynb", {"cells": [{"cell_type": "code",
                                                      "source": "print(1)"}]}) == (None, None)
 
@@ -166,6 +171,34 @@ def test_a_job_that_changes_its_fork_server_does_not_reach_the_next(sandbox):
     assert after["score"] == 10 and after["notes"] == [], after
 
 
+LEAVE_METADATA = """\
+import os, struct
+_none = struct.pack("<I", 2) + b"".join(struct.pack("<HHI", tag, 0, 0xFFFFFFFF) for tag in (1, 4, 32))
+for _path, _name, _value in [("/tmp", "user.left", b"1"), ("/dev/shm", "user.left", b"1"),
+                             ("..", "system.posix_acl_default", _none), ("..", "user.left", b"1")]:
+    os.setxattr(_path, _name, _value)  # the server's folder (the job folder's parent) too
+"""
+SEES_METADATA = "import os\nassert not os.listxattr('/tmp') and not os.listxattr('/dev/shm')\n"
+
+
+@pytest.mark.skipif(not SANDBOXED, reason="only the sandbox stops it (the refusal is tested)")
+def test_extended_attributes_and_acls_a_job_leaves_do_not_reach_the_next(sandbox):
+    """Round 5: a default ACL without rights on the fork server's folder and xattrs on /tmp and
+    /dev/shm: the server is replaced, and the next notebook sees none of it."""
+    first = servers.server_for(sandbox, 2)
+    attacked = copy.deepcopy(SOLUTION)
+    attacked["cells"].insert(1, {"cell_type": "code", "metadata": {}, "outputs": [],
+                                 "execution_count": None, "source": LEAVE_METADATA})
+    left = grade.grade_book("attack.ipynb", attacked, 60, 120, sandbox, seed=1)
+    assert left["notes"] == [], left  # it did set them all
+    assert servers.server_for(sandbox, 2) is not first
+    honest = copy.deepcopy(SOLUTION)
+    honest["cells"].insert(1, {"cell_type": "code", "metadata": {}, "outputs": [],
+                               "execution_count": None, "source": SEES_METADATA})
+    after = grade.grade_book("b.ipynb", honest, 60, 120, sandbox, seed=1)
+    assert after["score"] == 10 and after["notes"] == [], after
+
+
 FORGED = """\
 import json, os
 _forged = {"ready": ["x%d" % i for i in range(100000)],
@@ -183,26 +216,127 @@ def test_what_a_job_says_is_bounded(sandbox):
     assert result["score"] == 0 and len(json.dumps(result)) < 40_000, len(json.dumps(result))
 
 
-def _hog(n):
-    return [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(n)]
+FLOOD = """\
+import json, os, signal
+signal.signal(signal.SIGALRM, signal.SIG_IGN)  # the notebook's own alarm: ignored
+_lines = (json.dumps({"stopped": "x" * 20, "error": "y" * 400}) + "\\n").encode() * 200
+while True:
+    os.write(4, _lines)  # the job's replies pipe
+"""
+LOUD = "def jt_step(J, e):\n    raise RuntimeError('x' * 8_000_000)\n"
 
 
-def test_marks_do_not_depend_on_the_machine_s_load(sandbox):
-    """Exercise 5's solution (its check compiles ik.solve and runs it under a 30 s limit) and
-    exercise 2's, graded quiet and beside two busy processes per core: the same marks."""
+def test_what_a_job_writes_during_its_cells_is_bounded_and_ends_at_the_deadline(sandbox):
+    """Issue 50 item 2: notes on arrival at most MAX_NOTES, the grader's deadline holds while
+    lines keep coming (the job is ended by the grader, not by its server's later limit), and a
+    student's 8 MB error message is cut."""
+    worker = Worker([(1, FLOOD)], sandbox, exercise=2, limit=120, timeout=1)
+    with pytest.raises(ProcessEnded, match="ignored the alarm"):
+        worker.start()
+    assert len(worker.errors) + len(worker.notes) <= MAX_NOTES + 1, len(worker.notes)
+    loud = grade.grade_book("loud.ipynb", with_answer(LOUD), 60, 120, sandbox, seed=1)
+    assert loud["score"] == 0 and len(json.dumps(loud)) < 10_000, len(json.dumps(loud))
+
+
+def _jobs():
+    """The students' jobs of this process's sandboxes: children of a fork server (the same
+    command line: a fork) that descend from this test."""
+    table = {}
+    for name in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            with open(f"/proc/{name}/stat", "rb") as stat, open(f"/proc/{name}/cmdline", "rb") as cmd:
+                table[int(name)] = (int(stat.read().rsplit(b")", 1)[1].split()[1]),
+                                    b"grading.forkserver" in cmd.read())
+        except (OSError, ValueError, IndexError):
+            continue
+
+    def ours(pid):
+        while pid > 1 and pid != os.getpid():
+            pid = table.get(pid, (0, False))[0]
+        return pid == os.getpid()
+
+    return [pid for pid, (parent, server) in table.items()
+            if server and table.get(parent, (0, False))[1] and ours(pid)]
+
+
+def _busy(done):
+    """A machine busier than any load: the students' jobs get 0.25 s to run in every 1.25 s."""
+    def send(pids, number):
+        for pid in pids:
+            with contextlib.suppress(ProcessLookupError):  # a job that has just ended
+                os.kill(pid, number)
+
+    while not done.wait(0.25):
+        frozen = _jobs()
+        send(frozen, signal.SIGSTOP)
+        done.wait(1.0)
+        send(frozen, signal.SIGCONT)
+
+
+def test_honest_answers_keep_their_marks_on_a_machine_too_busy_for_their_time_limits(
+        sandbox, monkeypatch):
+    """Exercise 2's solution (the self-check's exercise) and exercise 5's (a solve under a
+    limit, which the grader compiles) graded while their jobs wait 1 s in every 1.25 s, longer
+    than every call's limit (cut to 0.5 s, and 3 s for a solve): the limits count the job's
+    CPU seconds, so the marks are full, on the first run."""
+    monkeypatch.setattr(check.verdicts, "TIME_LIMIT", 0.5)
+    monkeypatch.setattr(check.ex05_stop_rule, "SOLVE_LIMIT", 3.0)
     books = {n: json.loads((ROOT / "instructor" / "solutions" / n).read_text())
              for n in ("02_jt_step.ipynb", "05_stop_rule.ipynb")}
-    quiet = {n: grade.grade_book(n, b, 60, 180, sandbox, seed=3)["score"]
-             for n, b in books.items()}
-    hogs = _hog(2 * multiprocessing.cpu_count())
+    done = threading.Event()
+    busy = threading.Thread(target=_busy, args=(done,))
+    busy.start()
     try:
-        busy = {n: grade.grade_book(n, b, 60, 180, sandbox, seed=3)["score"]
-                for n, b in books.items()}
+        results = [grade.grade_book(n, b, 60, 180, sandbox, seed=3) for n, b in books.items()]
     finally:
-        for hog in hogs:
-            hog.kill()
-            hog.wait()
-    assert quiet == busy == {n: 10.0 for n in books}, (quiet, busy)
+        done.set()
+        busy.join()
+    assert [(r["score"], r["notes"]) for r in results] == [(10.0, [])] * 2, results
+
+
+def test_a_call_held_up_without_using_its_cpu_time_says_the_machine_is_busy(monkeypatch):
+    """A call that waits BUSY times its limit without using the CPU time the limit allows is
+    stopped with the words for what happened (here: the student's own wait)."""
+    monkeypatch.setattr(check.verdicts, "TIME_LIMIT", 0.1)
+    monkeypatch.setattr(check.verdicts, "BUSY", 3)
+    verdict = check.jt_step_verdict(lambda J, e: threading.Event().wait(60))
+    assert verdict.score == 0 and "this machine is busy (or your code waits)" in verdict.message
+
+
+FIRST_RUN = """\
+import os
+try:  # what a first run of this notebook left: an extended attribute on /tmp, a file in it
+    _again = os.getxattr("/tmp", "user.ikteach-run") == b"1"
+except OSError:
+    _again = False
+_again = _again or os.path.exists("/tmp/ikteach-run")
+if not _again:
+    open("/tmp/ikteach-run", "w").close()
+    try:
+        os.setxattr("/tmp", "user.ikteach-run", b"1")
+    except OSError:
+        pass
+
+
+def jt_step(J, e):
+    if not _again:
+        while True:  # past the time limit, so that the grader runs the notebook again
+            pass
+""" + JT
+ASKS_AGAIN = "def jt_step(J, e):\n    raise RuntimeError('did not return within 5 s')\n"
+
+
+@pytest.mark.skipif(not SANDBOXED, reason="a fresh sandbox is what the re-run starts in")
+def test_a_run_again_comes_only_from_the_grader_s_time_limit_and_starts_clean(sandbox,
+                                                                                 monkeypatch):
+    """Re-runs (issue 50 item 4): a student's error in the time limit's words starts none; a
+    re-run finds nothing the first run left (files, extended attributes)."""
+    monkeypatch.setattr(check.verdicts, "TIME_LIMIT", 0.3)
+    asks = grade.grade_book("asks.ipynb", with_answer(ASKS_AGAIN), 60, 120, sandbox, seed=1)
+    assert asks["score"] == 0 and grade.RERUN not in asks["notes"], asks
+    again = grade.grade_book("again.ipynb", with_answer(FIRST_RUN), 60, 120, sandbox, seed=1)
+    assert again["score"] == 0 and grade.RERUN in again["notes"], again
+    assert "did not return within 0.3 s of CPU time" in again["message"], again
 
 
 def test_any_two_folders_get_two_rows_and_two_feedback_files():
@@ -210,6 +344,47 @@ def test_any_two_folders_get_two_rows_and_two_feedback_files():
     names = [latin1, "M\\xfcller", "Müller", "Mu\u0308ller", "Anna", "anna", "x" * 255]
     shown = report.labels(names)
     assert len(set(shown.values())) == len(names), shown
+    forged = names + [shown["Anna"], shown["Anna"] + " [0]"]  # folders named as hashed labels
+    assert len(set(report.labels(forged).values())) == len(forged), report.labels(forged)
     files = {report.file_name(label).casefold() for label in shown.values()}
     assert len(files) == len(names), files
     assert shown["x" * 255] == "x" * 255 and shown[latin1].startswith("M\\xfcller [")
+
+
+def test_the_feedback_counts_the_notebook_the_csv_counts_and_names_the_others(tmp_path):
+    """Issue 50 item 3: the unfilled template and the answer as a browser's second download,
+    in either order: the CSV and the feedback both count the answer and name the template."""
+    def result(name, score, message):
+        return {"file": name, "exercise": 2, "how": "by its metadata", "score": score,
+                "max": 10.0, "status": "", "message": message, "notes": [], "answer": ""}
+
+    template = result("02_jt_step.ipynb", 0.0, "Exercise 2: not yet implemented")
+    answer = result("02_jt_step (1).ipynb", 10.0, "Exercise 2: passed, 10/10")
+    for order in ([answer, template], [template, answer]):
+        rows = report.write_results({"kim": order}, {"kim": []}, tmp_path / "g.csv",
+                                    tmp_path / "fb", "none")
+        page = (tmp_path / "fb" / "kim.txt").read_text()
+        assert rows[0]["ex2"] == 10.0 and "Total: 10/70" in page, page
+        assert "Exercise 2 (02_jt_step (1).ipynb): 10/10" in page, page
+        assert "not counted (the best notebook counts): 02_jt_step.ipynb: 0/10" in page, page
+
+
+def test_a_student_s_notebooks_are_never_graded_at_once():
+    """Round 5 (a relay through the page cache between two of one student's notebooks under
+    --jobs 2): each student's notebooks are in one grading process's share, in order."""
+    jobs_list = [(s, f"{s}/{n:02d}.ipynb", None) for n in (1, 2, 5) for s in ("ann", "bo", "cy")]
+    shares = grade.by_student(jobs_list, 2)
+    assert sorted(job for share in shares for job in share) == sorted(jobs_list)
+    for student in ("ann", "bo", "cy"):
+        assert sum(any(job[0] == student for job in share) for share in shares) == 1
+    assert all(share == [job for job in jobs_list if job in share] for share in shares)
+
+
+def test_an_ordinary_user_without_a_cpu_share_grades_one_notebook_at_a_time():
+    """Issue 50 item 1: without a cpu cgroup per sandbox, a fork storm would take a concurrent
+    classmate's CPU: one notebook at a time, said in the log."""
+    from types import SimpleNamespace
+    assert grade.jobs_for(SimpleNamespace(controlled={"pids", "cpu"}), 2) == (2, None)
+    jobs, why = grade.jobs_for(SimpleNamespace(controlled={"pids"}), 2)
+    assert jobs == 1 and "no CPU share per sandbox" in why
+    assert grade.jobs_for(SimpleNamespace(controlled=set()), 1) == (1, None)

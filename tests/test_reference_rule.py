@@ -3,8 +3,8 @@ answer" that the grader can stop scores nothing, because the sandbox of the grad
 holds that answer only as a stub (grading/reference.py); the answers a notebook carries in
 itself (a marshalled blob, source typed in) are reported in grades.csv's `copied` column and
 the feedback, for the instructor; a lookup table of the instant check's cases meets hidden
-cases. Beside them an honest student (the instructor's solutions) keeps 70/70, and the class
-gets its grades.csv. Without bubblewrap the same run is made with --no-sandbox (the copy of
+cases. The class gets its grades.csv (that the instructor's solutions keep 70/70 and are not
+reported, beside hostile students, is tests/test_grade.py's). Without bubblewrap the same run is made with --no-sandbox (the copy of
 ikteach is then what PYTHONPATH points at)."""
 import base64
 import csv
@@ -155,6 +155,10 @@ def planar_jacobian(lengths, theta):
 '''
 
 
+FORGE_FINGERPRINTS = ("import ikteach.course.grading.reference as _reference\n"
+                      "_reference.fingerprints = lambda codes: {}\n")
+
+
 def by_hand():
     """ikteach's pinv_step typed into the notebook, names changed: plagiarism, reported."""
     source = "".join(line for line in inspect.getsource(pinv.pinv_step.__wrapped__)
@@ -187,8 +191,13 @@ SPELLINGS = [
     ("selfcheck_answer", 2, SELFCHECK, 0, "`jt_step` not found in the notebook", False),
     ("marshal_at_run_time", 3, MARSHAL_AT_RUN_TIME, 0, "`pinv_step` raised ReferenceBlocked",
      False),
-    ("marshal_blob", 3, None, 10, "has the same code as ikteach.core.pinv.pinv_step", True),
+    # code loaded at run time is not what the notebook shows: the report (computed from the
+    # source, outside the student's process) does not see it; the marks are the answer's
+    ("marshal_blob", 3, None, 10, "passed, 10/10", False),
     ("typed_in", 3, None, 10, "`pinv_step` has the same code as ikteach.core.pinv.pinv_step",
+     True),
+    # round 5: the job's own fingerprints replaced by a cell; the source's are computed apart
+    ("typed_in_forged", 3, None, 10, "`pinv_step` has the same code as ikteach.core.pinv.pinv_step",
      True),
     ("lookup_table", 1, None, 2, "lever arms x", False),
     # the paths the instant check follows too (test_instant_check_agrees)
@@ -222,8 +231,9 @@ def write_student(subs, student, number, source):
 def graded(tmp_path_factory):
     base = tmp_path_factory.mktemp("reference-rule")
     subs = base / "submissions"
-    shutil.copytree(SOLUTIONS, subs / "honest")
+    subs.mkdir()
     sources = {"marshal_blob": marshal_blob(), "typed_in": by_hand(),
+               "typed_in_forged": FORGE_FINGERPRINTS + by_hand(),
                "lookup_table": lookup_table(), "fingerprint_stall": fingerprint_stall()}
     for student, number, source, *_ in SPELLINGS:
         write_student(subs, student, number, source or sources[student])
@@ -236,13 +246,6 @@ def graded(tmp_path_factory):
     rows = {r["student"]: r for r in csv.DictReader(out.open(encoding="utf-8"))}
     feedback = {p.stem: p.read_text(encoding="utf-8") for p in (base / "out" / "feedback").glob("*.txt")}
     return rows, feedback, run.stdout
-
-
-def test_the_honest_student_keeps_full_marks_and_is_not_reported(graded):
-    rows, feedback, _ = graded
-    assert [float(rows["honest"][f"ex{n}"]) for n in check.NUMBERS] == [10.0] * 7
-    assert float(rows["honest"]["total"]) == 70.0 and rows["honest"]["copied"] == ""
-    assert "for the instructor" not in feedback["honest"]
 
 
 @pytest.mark.parametrize("student, number, source, marks, line, copied", SPELLINGS)

@@ -7,8 +7,9 @@
     python -m ikteach.course.grade --gradescope OUT.zip      (a Gradescope autograder bundle)
 
 SUBMISSIONS_DIR holds one folder per student (the folder name is the student), each with that
-student's exercise notebooks. A notebook is taken for an exercise by its metadata, else its
-content (the functions it defines, the check it calls), else an NN_ in its name (identify()).
+student's exercise notebooks. A notebook is taken for an exercise by its content (the
+functions it defines, the check it calls), else its metadata, else an NN_ in its name
+(identify()).
 Each notebook is one job, in a sandbox (ikteach.course.grading.sandbox: bubblewrap, an
 unprivileged user without capabilities, no network, a read-only whitelist of the machine,
 resource limits; where no sandbox works the grader refuses unless --no-sandbox):
@@ -18,10 +19,12 @@ resource limits; where no sandbox works the grader refuses unless --no-sandbox):
 2. then ik.check runs in the grader's own process on hidden cases (the instant check's kinds
    with numbers drawn from a seed at grading time, logged; --seed repeats a run), calling the
    functions the cells left in the shell's namespace through a pipe, each call under its time
-   limit (grading/remote.py). So nothing a notebook does to modules, builtins, stdout or
-   files changes a score. A graded name that is not a function written in the notebook gets 0
-   (grading/own_code.py). A check that ran past its time limit is run again in a fresh job
-   before the timeout counts (a busy machine, a first compile).
+   limit (grading/remote.py): limits in CPU seconds of the job, so a machine's load changes
+   no mark ("this machine is busy" where a call waited far longer than its limit). So nothing
+   a notebook does to modules, builtins, stdout or files changes a score. A graded name that
+   is not a function written in the notebook gets 0 (grading/own_code.py). A notebook whose
+   call the checks' time limit stopped is graded again from scratch, in a fresh sandbox,
+   before the timeout counts.
 The job sees a copy of ikteach in which the exercise's reference answers are stubs that raise,
 without the checker and the self-check (grading/reference.py: what the grader guarantees and
 what it only reports - code copied from ikteach, in grades.csv's `copied`). It is a fresh child
@@ -45,6 +48,7 @@ per student (FEEDBACK/<student>.txt, by default a `feedback` folder next to the 
 starts with what the sandbox enforces and what it cannot on this machine.
 """
 import argparse
+import collections
 import dataclasses
 import functools
 import os
@@ -64,7 +68,8 @@ NOTEBOOK_TIMEOUT = 120.0  # seconds for all of a student's cells
 GRADE_TIMEOUT = 180.0     # seconds for a notebook's checks: every call
 GRACE = 15.0              # the fork server's kill comes first; then the grader ends it all
 MAX_NOTEBOOKS = 3 * 7      # notebooks graded per student (the rest: a note)
-TIMED_OUT = "did not return within"  # the checks' words for a call past its time limit
+RERUN = ("a check ran past its time limit and was run again in a fresh sandbox: the marks "
+         "are the second run's")
 INSTRUCTOR = Path(__file__).resolve().parents[2] / "instructor"  # the solutions: hidden
 
 __all__ = ["grade_all", "grade_notebook", "grade_book", "exercise_number", "main",
@@ -104,18 +109,19 @@ def _from_content(book):
 
 
 def identify(path, book):
-    """(exercise number or None, how it was recognised): the notebook's metadata
-    (ikteach.exercise), else its content (the functions it defines, the check it calls), else
-    an NN_ in its file name."""
+    """(exercise number or None, how it was recognised): its content (the functions it
+    defines, the check it calls), else the notebook's metadata (ikteach.exercise: a student
+    who started exercise 3 from the exercise 2 file keeps exercise 2's), else an NN_ in its
+    file name."""
     meta = book.get("metadata") if isinstance(book, dict) else None
     meta = meta.get("ikteach") if isinstance(meta, dict) else None
-    number = meta.get("exercise") if isinstance(meta, dict) else None
-    if isinstance(number, int) and number in EXERCISE_NUMBERS:
-        return number, "by its metadata"
-    if isinstance(book, dict):
-        number, why = _from_content(book)
-        if number is not None:
-            return number, why
+    said = meta.get("exercise") if isinstance(meta, dict) else None
+    said = said if isinstance(said, int) and said in EXERCISE_NUMBERS else None
+    number, why = _from_content(book) if isinstance(book, dict) else (None, None)
+    if number is not None and number != said:
+        return number, why + (f"; its metadata says exercise {said}" if said else "")
+    if said is not None:
+        return said, "by its metadata"
     number = _from_name(path)
     return (number, "by its file name") if number is not None else (None, None)
 
@@ -141,9 +147,9 @@ def _answer_text(book):
 
 def _copied(number, held):
     """Lines for the instructor: the notebook's functions whose code is exercise `number`'s
-    reference (`held`: the fingerprints of the code the notebook's namespace holds, computed
-    in its job, under its limits: nothing of a student's code is compiled here). Reported,
-    never scored (grading/reference.py)."""
+    reference (`held`: the fingerprints of the code its cells' source defines, computed in a
+    job where no student code has run: nothing of a student's code is compiled here, nothing
+    is taken from the student's process). Reported, never scored (grading/reference.py)."""
     from . import check
     from .grading import reference
 
@@ -152,29 +158,36 @@ def _copied(number, held):
 
 
 def _run(number, book, sandbox, timeout, grade_timeout, seed=None):
-    """(verdict or None, notes, copied): the notebook's cells and then ik.check's calls in one
-    job (grading/cells.py), the verdict computed in this process on the hidden cases drawn
-    from `seed`; notes: the cells' errors and what went wrong on the way."""
+    """(verdict or None, notes, copied, stopped): the notebook's cells and then ik.check's
+    calls in one job (grading/cells.py), the verdict computed in this process on the hidden
+    cases drawn from `seed`, each call's limit counting the job's CPU seconds; notes: the
+    cells' errors and what went wrong on the way; stopped: a time limit of the checks ended a
+    call."""
     from . import check
+    from .check.verdicts import CPU_CLOCK
     from .grading.extract import code_cells
     from .grading.remote import ProcessEnded, Worker
 
     module = check.EXERCISES[number]
     worker = Worker(code_cells(book), sandbox, exercise=number, graded=module.FUNCTIONS,
                     limit=grade_timeout, timeout=timeout)
+    clock = CPU_CLOCK.set(worker.cpu_seconds)
     try:
+        held = worker.held()  # before the notebook's job: a server runs one at a time
         try:
             worker.start()
         except (ProcessEnded, ValueError) as exc:  # died, hung, or answered garbage
-            return None, worker.errors + (worker.notes or [f"nothing could be graded: {exc}"]), []
+            return (None, worker.errors + (worker.notes or [f"nothing could be graded: {exc}"]),
+                    [], False)
         notes = worker.errors + worker.notes
-        copied = _copied(number, worker.held)
+        copied = _copied(number, held)
         if worker.foreign:  # a graded name bound to ikteach's (or anyone's) code: no marks
             return (check.registry.refuse(number, " ".join(worker.foreign.values())), notes,
-                    copied)
+                    copied, False)
         namespace = {name: worker.function(name) for name in worker.names}
-        return check.grade(number, namespace, seed=seed), notes, copied
+        return check.grade(number, namespace, seed=seed), notes, copied, worker.stopped
     finally:
+        CPU_CLOCK.reset(clock)
         worker.end()
 
 
@@ -189,9 +202,9 @@ def grade_book(name, book, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT
     one - never the instant check's public cases); returns a dict: file, exercise, how (how the
     exercise was recognised), score, max, status, message, notes (what went wrong on the way),
     answer (the written answer, if any), copied (functions whose code is ikteach's answer: for
-    the instructor), seed. A check that ran past its time limit is run once more, in a fresh
-    job, before the timeout costs marks (the first run may have been slowed by a busy machine
-    or by compiling the check)."""
+    the instructor), seed. A notebook whose call the checks' time limit stopped is run once
+    more, in a fresh sandbox, before the timeout costs marks."""
+    from .grading import servers
     from .grading.sandbox import Sandbox
 
     sandbox = sandbox or Sandbox()  # raises SandboxUnavailable where there is none
@@ -206,14 +219,13 @@ def grade_book(name, book, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT
     started = time.monotonic()
     try:
         result["answer"] = _answer_text(book)
-        verdict, notes, result["copied"] = _run(number, book, sandbox, timeout, grade_timeout,
-                                                seed)
-        if verdict is not None and TIMED_OUT in verdict.message:  # confirmed before it counts
-            again, notes_again, _ = _run(number, book, sandbox, timeout, grade_timeout, seed)
+        verdict, notes, result["copied"], stopped = _run(number, book, sandbox, timeout,
+                                                         grade_timeout, seed)
+        if stopped:  # the grader's own time limit: confirmed, from a clean start, before it counts
+            servers.close_all()
+            again, notes_again, _, _ = _run(number, book, sandbox, timeout, grade_timeout, seed)
             if again is not None:
-                verdict, notes = again, notes_again + [
-                    "a check ran past its time limit and was run again in a fresh process: "
-                    "the marks are the second run's"]
+                verdict, notes = again, notes_again + [RERUN]
         result["notes"] = notes[:40]
         if verdict is None:
             result["message"] = "no grade: your code could not be loaded for the checks"
@@ -245,23 +257,51 @@ def grade_notebook(path, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT, 
         return _result(path.name, number, f"could not grade the notebook: {type(exc).__name__}")
 
 
+def by_student(jobs_list, jobs):
+    """jobs_list in `jobs` shares, each student's notebooks in one share (graded one after
+    another: a student's notebooks never run at once, so none reaches another exercise's
+    reference through what they share, e.g. the page cache)."""
+    counts = collections.Counter(student for student, _, _ in jobs_list)
+    sizes, share = [0] * jobs, {}
+    for student, count in sorted(counts.items(), key=lambda c: (-c[1], repr(c[0]))):
+        share[student] = sizes.index(min(sizes))  # the most notebooks first, to the emptiest
+        sizes[share[student]] += count
+    return [[job for job in jobs_list if share[job[0]] == n] for n in range(jobs)]
+
+
+def jobs_for(sandbox, jobs):
+    """(notebooks graded at once, the log's line or None): one where this user may give no
+    sandbox its own CPU share (no cpu cgroup: an ordinary user without a delegated one), so a
+    student's busy processes never take a classmate's CPU."""
+    if jobs > 1 and "cpu" not in sandbox.controlled:
+        return 1, (f"--jobs {jobs}: graded one notebook at a time instead (no CPU share per "
+                   "sandbox here: a cpu cgroup this user may make, e.g. a delegated user scope)")
+    return jobs, None
+
+
+def _grade_share(share, timeout, grade_timeout, sandbox, seed):
+    return [grade_notebook(nb, timeout, grade_timeout, sandbox, problem, seed)
+            for _, nb, problem in share]
+
+
 def _grade_jobs(jobs_list, jobs, timeout, grade_timeout, sandbox, seed):
-    """Every notebook's result, in order; a worker that dies costs only its notebooks."""
+    """Every notebook's result, in order; a grading process that dies costs its share."""
     if jobs <= 1:
-        return [grade_notebook(nb, timeout, grade_timeout, sandbox, problem, seed)
-                for _, nb, problem in jobs_list]
+        return _grade_share(jobs_list, timeout, grade_timeout, sandbox, seed)
+    shares = [s for s in by_student(jobs_list, jobs) if s]
     with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
-        futures = [pool.submit(grade_notebook, nb, timeout, grade_timeout, sandbox, problem,
-                               seed)
-                   for _, nb, problem in jobs_list]
-        outcomes = []
-        for (_, nb, _), future in zip(jobs_list, futures):
+        futures = [pool.submit(_grade_share, share, timeout, grade_timeout, sandbox, seed)
+                   for share in shares]
+        outcomes = {}
+        for share, future in zip(shares, futures):
             try:
-                outcomes.append(future.result())
+                results = future.result()
             except Exception as exc:  # noqa: BLE001 - a crashed grading process
-                outcomes.append(_result(os.path.basename(nb), None, "could not grade the "
-                                        f"notebook: the grading process failed ({exc!r:.200})"))
-    return outcomes
+                results = [_result(os.path.basename(nb), None, "could not grade the notebook: "
+                                   f"the grading process failed ({exc!r:.200})")
+                           for _, nb, _ in share]
+            outcomes.update({id(job): r for job, r in zip(share, results)})
+    return [outcomes[id(job)] for job in jobs_list]
 
 
 def grade_all(submissions, out, feedback=None, timeout=NOTEBOOK_TIMEOUT, jobs=1,
@@ -299,6 +339,9 @@ def grade_all(submissions, out, feedback=None, timeout=NOTEBOOK_TIMEOUT, jobs=1,
             log(f"  - {line}")
         seed = secrets.randbits(63) if seed is None else int(seed)
         log(f"hidden cases: seed {seed} (--seed {seed} grades on the same cases again)")
+        jobs, why = jobs_for(sandbox, limits.jobs)
+        if why:
+            log(why)
         selfcheck.run(functools.partial(grade_book, seed=seed), sandbox, timeout, grade_timeout)
         log("self-check: a known-good answer got 10/10 and a wrapper of ikteach's own got 0")
         for name in ignored:

@@ -305,13 +305,30 @@ def replace_cell(base, name, source):
     return book
 
 
-def with_cell_magic(base, magic):
-    """`base` with every cell that defines a function starting with a cell magic (%%time)."""
+# issue 50: magics a student types out of habit, on the first lines of a helper cell
+LINE_MAGICS = {1: "%matplotlib widget", 2: "%time _t = 1", 3: "%timeit -n1 -r1 1",
+               4: "%load_ext autoreload\n%autoreload 2", 5: "%pip install --quiet ikteach",
+               6: "!ls\n_files = !ls", 7: '%config InlineBackend.figure_format = "retina"'}
+
+
+def with_magics(base):
+    """`base` with every cell that defines a function starting with a magic (%%time, or
+    `%matplotlib inline` in even exercises), and each function calling a helper from a cell that
+    starts with `%matplotlib inline` and a line magic: a magic that takes its cell with it
+    costs every mark (issue 50)."""
     book = nbformat.read(base, as_version=4)
+    magic = "%matplotlib inline" if int(Path(base).name[:2]) % 2 == 0 else "%%time"
     for cell in book.cells:
+        if cell.cell_type == "code" and "def " in cell.source:
+            lines = [(line + "\n    _log()") if line.startswith("def ") else line
+                     for line in cell.source.splitlines()]
+            cell.source = f"{magic}\n" + "\n".join(lines)
         if cell.cell_type == "code":
-            cell.source = f"{magic}\n{cell.source}" if "def " in cell.source else cell.source
             cell.outputs, cell.execution_count = [], None
+    at = next(i for i, c in enumerate(book.cells) if c.cell_type == "code" and "def " in c.source)
+    book.cells.insert(at, nbformat.v4.new_code_cell(
+        f"%matplotlib inline\n{LINE_MAGICS[int(Path(base).name[:2])]}\n\n\n"
+        "def _log(*values):\n    return values\n"))
     return book
 
 
@@ -363,7 +380,7 @@ def main():
     write("ipc_relay", "02_jt_step.ipynb", replace_cell(SOLUTION / "02_jt_step.ipynb", "jt_step",
                                                         RELAY))
     for path in sorted(SOLUTION.glob("*.ipynb")):
-        write("cell_magic", path.name, with_cell_magic(path, "%%time"))
+        write("cell_magic", path.name, with_magics(path))
     # graded in a class of their own (tests/test_isolation.py), beside an honest classmate
     write("storm_class/cpu_storm", "02_jt_step.ipynb",
           notebook(SOLUTION / "02_jt_step.ipynb", [CPU_STORM]))

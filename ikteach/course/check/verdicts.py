@@ -6,12 +6,14 @@ run() returns None (the part passed) or the message of its smallest failing case
 to _evaluate(number, title, function_names, parts).
 """
 import contextlib
+import contextvars
 import dataclasses
 import functools
 import os
 import signal
 import sys
 import threading
+import time
 import traceback
 import warnings
 
@@ -20,8 +22,11 @@ import numpy as np
 from ...core.solve import StopSolve
 
 POINTS = 10
-TIME_LIMIT = 5.0    # seconds for one call of a student function
-SOLVE_LIMIT = 30.0  # seconds for a whole ik.solve run with a student step function
+TIME_LIMIT = 5.0    # CPU seconds for one call of a student function
+SOLVE_LIMIT = 30.0  # CPU seconds for a whole ik.solve run with a student step function
+BUSY = 30           # wall seconds per CPU second of a limit before a call counts as held up
+# the student's CPU seconds so far: this process's in a kernel (the grader sets its job's)
+CPU_CLOCK = contextvars.ContextVar("CPU_CLOCK", default=time.process_time)
 SEED = 2024
 _PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # ikteach/
 
@@ -47,14 +52,21 @@ class _Abort(_Fail):
 
 @contextlib.contextmanager
 def _time_limit(seconds):
-    """SIGALRM-based limit in the main thread (the kernel's); elsewhere no limit."""
+    """A limit on the student's CPU seconds (CPU_CLOCK), checked by SIGALRM in the main thread
+    (the kernel's; elsewhere no limit); a call held up BUSY times as long in wall time (a busy
+    machine, or code that waits) stops too. Raises _TimeLimit(CPU seconds, wall seconds)."""
     if (threading.current_thread() is not threading.main_thread()
             or not hasattr(signal, "setitimer")):
         yield
         return
+    clock = CPU_CLOCK.get()
+    cpu, wall = clock(), time.monotonic()
 
     def _handler(signum, frame):
-        raise _TimeLimit()
+        used, waited = clock() - cpu, time.monotonic() - wall
+        if used >= seconds or waited >= BUSY * seconds:
+            raise _TimeLimit(used, waited)
+        signal.setitimer(signal.ITIMER_REAL, max(seconds - used, 0.05))
 
     previous = signal.signal(signal.SIGALRM, _handler)
     signal.setitimer(signal.ITIMER_REAL, seconds)
@@ -87,8 +99,13 @@ def _call(fn, name, case, *args, limit=None):
         with _time_limit(limit), np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)  # NaN is reported by the check
             return fn(*args)
-    except _TimeLimit:
-        raise _Abort(f"`{name}` did not return within {limit:g} s on {case} - an endless loop?"
+    except _TimeLimit as stop:
+        used, waited = stop.args
+        if used >= limit:
+            raise _Abort(f"`{name}` did not return within {limit:g} s of CPU time on {case} - "
+                         "an endless loop?") from None
+        raise _Abort(f"`{name}` did not return within {waited:.0f} s on {case} but had only "
+                     f"{used:.1f} s of CPU time: this machine is busy (or your code waits)"
                      ) from None
     except NotImplementedError:
         raise _NotYet(name) from None

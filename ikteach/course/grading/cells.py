@@ -11,6 +11,8 @@ interrupted (SIGALRM) and the rest skipped ({"stopped": N}); a notebook that ign
 is killed from outside by the fork server and the grader. Then {"ready": ...} (remote.serve)
 and the calls. Code objects compile as `<cell N>` (tracebacks and grading/own_code.py name them);
 a cell starting with %%time or %%capture runs as its body (their own compile names it otherwise).
+Magics run as in a kernel without a screen (`%matplotlib inline` draws into memory); shell lines
+(`!`, %pip, %conda) are skipped, and a magic that fails is a note: the rest of its cell runs.
 """
 import json
 import os
@@ -39,13 +41,34 @@ def error_line(number, exc):
 
 
 def shell():
-    """IPython's shell, without history (no database, no thread); cells compile as <cell N>."""
+    """IPython's shell, without history (no database, no thread); cells compile as <cell N>;
+    `notes` collects the magics it skipped."""
     from IPython.core.interactiveshell import InteractiveShell
     from traitlets.config import Config
 
+    class Shell(InteractiveShell):
+        notes = []
+
+        def enable_gui(self, gui=None):  # a kernel without a screen: no event loop to start
+            pass
+
+        def run_line_magic(self, magic_name, line, _stack_depth=1):
+            if magic_name in ("pip", "conda", "mamba", "uv"):
+                return self.system(f"%{magic_name} {line}", "")
+            try:
+                return super().run_line_magic(magic_name, line, _stack_depth + 1)
+            except Exception as exc:
+                why = str(exc).splitlines()[0][:200] if str(exc) else ""
+                self.notes.append(f"`%{magic_name} {line}`"[:80] + " was skipped "
+                                  f"({type(exc).__name__[:80]}: {why})")
+
+        def system(self, cmd, mark="!"):
+            self.notes.append(f"`{mark}{cmd}`"[:80] + " was skipped: the grader runs no shell "
+                              "commands or installs")
+
     config = Config()
     config.HistoryManager.enabled = False
-    instance = InteractiveShell.instance(config=config)
+    instance = Shell.instance(config=config)
     instance.compile.get_code_name = lambda raw, transformed, number: f"<cell {number}>"
     return instance
 
@@ -71,6 +94,8 @@ def run(instance, cells, send, timeout):
                 return number
             if exc is not None:
                 send({"error": error_line(number, exc)})
+            while instance.notes:
+                send({"error": f"cell {number}: {instance.notes.pop(0)}"})
     except NotebookTime:  # between cells, or in IPython's own code
         send({"stopped": "the end"})
         return False

@@ -15,7 +15,8 @@ job pipes; everything else the server holds is closed in it. When the child ends
 grader says so, or its time limit passes) the server, as PID 1, kills every other process of
 the namespace (kill(-1): daemons, setsid, fork storms), reaps them, removes the job's folder,
 whatever appeared in the sandbox's writable /tmp and /dev, and SysV IPC objects; if anything
-there that existed before was changed (a /dev node replaced, /tmp's mode), or its own limits,
+there that existed before was changed (a /dev node replaced, /tmp's mode, an extended attribute
+or ACL there or on the server's folder), or its own limits,
 priority, CPU set or OOM score are not those it started with (a job may `prlimit` its server:
 same uid), it says `dirty` and the grader starts a fresh server: every job starts with the
 limits the grader set from outside. In the sandbox a job's child may write only beneath its
@@ -25,7 +26,8 @@ not dumpable (no ptrace, no /proc/1/mem) and, as init, ignores every signal from
 namespace that it has no handler for.
 
 Control messages (JSON over a SOCK_SEQPACKET socket, the job's pipes passed with SCM_RIGHTS):
-  -> {"job": id, "kind": "notebook"|"probe", "limit": s}  + fds (requests in, replies out)
+  -> {"job": id, "kind": "notebook"|"fingerprints"|"probe", "limit": s}  + fds (requests in,
+                                                            replies out)
   -> {"end": id}                                            the grader is done with the job
   <- {"done": id, "status": exit status or null, "timed_out": bool, "dirty": bool}
 """
@@ -71,9 +73,18 @@ def _prctl(libc, option, value):
         libc.prctl(option, value, 0, 0, 0)
 
 
+def _xattrs(path):
+    """A path's extended attributes, POSIX ACLs included (they are xattrs)."""
+    try:
+        return tuple(sorted((name, os.getxattr(path, name, follow_symlinks=False))
+                            for name in os.listxattr(path, follow_symlinks=False)))
+    except (OSError, AttributeError):  # no xattrs here (a file system, or not Linux)
+        return ()
+
+
 def _state(roots, keep):
-    """{path: (mode, uid, inode)} of everything under `roots` (not following links), except
-    what lies inside `keep` (the server's own folder)."""
+    """{path: (mode, uid, inode, xattrs)} of everything under `roots` (not following links),
+    except what lies inside `keep` (the server's own folder)."""
     seen = {}
     for root in roots:
         for folder, dirs, files in os.walk(root):
@@ -84,9 +95,9 @@ def _state(roots, keep):
                     st = os.lstat(path)
                 except OSError:
                     continue
-                seen[path] = (st.st_mode, st.st_uid, st.st_ino)
+                seen[path] = (st.st_mode, st.st_uid, st.st_ino, _xattrs(path))
     st = os.lstat(keep)
-    seen[keep] = (st.st_mode, st.st_uid, st.st_ino)
+    seen[keep] = (st.st_mode, st.st_uid, st.st_ino, _xattrs(keep))
     return seen
 
 
@@ -285,6 +296,11 @@ def _child(kind, fds, job, control, sandboxed):
         if kind == "notebook":
             from ikteach.course.grading import cells
             cells.main(requests, replies)
+        elif kind == "fingerprints":  # of the cells' source, where no student code has run
+            from ikteach.course.grading import reference
+            cells = json.loads(os.fdopen(requests, encoding="utf-8", errors="replace").readline())
+            found = reference.source_fingerprints([(int(n), str(s)) for n, s in cells["cells"]])
+            os.write(replies, (json.dumps(found) + "\n").encode())
         elif kind == "probe":
             from ikteach.course.grading import probe
             probe.job(requests, replies)

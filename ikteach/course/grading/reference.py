@@ -15,11 +15,12 @@ The check cell (reached()): the references a student's functions reach through w
 code names (globals, imports at any level, attribute chains, literal strings, defaults,
 closures, classes, containers, and ikteach's own functions on the way) give the same 0.
 
-Reported, not prevented: a notebook that carries ikteach's code in itself (its source typed or
-pasted in, a marshalled code object, an exec'd string). That is copying, which only a reader
-can judge; fingerprint() makes an exact copy visible: a code object's operations, names,
-docstrings, file names and line numbers ignored, compared with the references' (copied():
-what matched and how many operations). Reordered, rewritten or split code is not seen. The
+Reported, not prevented: a notebook that carries ikteach's code in its cells (its source typed
+or pasted in). That is copying, which only a reader can judge; fingerprint() makes an exact
+copy visible: a code object's operations, names, docstrings, file names and line numbers
+ignored, compared with the references' (copied(): what matched and how many operations), for
+the cells' source compiled in a job where no student code has run (source_fingerprints).
+Reordered, rewritten or split code, and code loaded at run time, is not seen. The
 work is bounded whatever a file holds (MAX_CODES, MAX_CODE_BYTES, MAX_TOTAL_BYTES).
 """
 import ast
@@ -111,7 +112,7 @@ MIN_OPERATIONS = 20      # shorter functions (a one-line wrapper) are too common
 MAX_CODE_BYTES = 16384   # longer code cannot be a reference's (the longest is ~1 kB): skipped
 MAX_CODES = 400          # code objects compared per notebook (the rest are not)
 MAX_TOTAL_BYTES = 1 << 20  # compiled code read per notebook, in all
-MAX_NAMES = 300          # names of one function followed (the instant check, held_code)
+MAX_NAMES = 300          # names of one function followed (the instant check)
 MAX_REACHED = 20000      # objects followed from a namespace or a student's functions
 
 
@@ -311,14 +312,6 @@ def _content(cell):
         return cell.cell_contents
     except ValueError:  # an empty cell
         return None
-
-
-def held_code(namespace):
-    """The code objects a namespace holds (in the worker, after the student's statements):
-    its functions' and those they reach, and bare code objects (a marshalled blob)."""
-    found = _reachable(list(namespace.values()))
-    return ([o.__code__ for o in found if isinstance(o, types.FunctionType)]
-            + [o for o in found if isinstance(o, types.CodeType)])
 
 
 def reached(functions, references):

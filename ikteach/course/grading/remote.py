@@ -14,7 +14,6 @@ import importlib
 import json
 import os
 import select
-import signal
 import time
 import traceback
 
@@ -23,7 +22,7 @@ CALL_LIMIT = 600.0       # last-resort limit on one reply (the checks' own limit
 MAX_REPLY = 64 << 20     # bytes
 MAX_NOTES, MAX_NAMES, MAX_HELD = 30, 200, 200
 GRACE = 15.0             # seconds past the cells' own alarm before the job is killed
-HELD_LIMIT = 5.0         # seconds for the fingerprints of the code a notebook holds
+HELD_LIMIT = 5.0         # seconds for the fingerprints of the code a notebook's source defines
 
 
 class ProcessEnded(Exception):
@@ -111,8 +110,8 @@ def decode(data, call=None):
             return fn
         return functools.partial(fn, *decode(data["args"]), **decode(data["kwargs"]))
     if "__opaque__" in data:
-        kind = type(str(data["__opaque__"]) or "object", (_Opaque,), {})
-        return kind(str(data.get("repr", "")))
+        kind = type(str(data["__opaque__"])[:60] or "object", (_Opaque,), {})
+        return kind(str(data.get("repr", ""))[:80])
     return {}
 
 
@@ -130,32 +129,16 @@ def _student_line(exc):
     return ""
 
 
-class _TimeUp(BaseException):
-    pass
-
-
-def _time_up(signum, frame):
-    raise _TimeUp()
-
-
 def serve(namespace, graded, requests, send):
     """After the cells (cells.py): say what the namespace holds, then answer calls, one JSON
     line each, until the grader closes the requests."""
     from ikteach.core.solve import StopSolve
-    from ikteach.course.grading import own_code, reference
+    from ikteach.course.grading import own_code
 
-    signal.signal(signal.SIGALRM, _time_up)
-    signal.setitimer(signal.ITIMER_REAL, HELD_LIMIT)
-    try:  # reported, not trusted; under its own limit (a cell crafted to make it slow)
-        held = reference.fingerprints(reference.held_code(namespace))
-    except _TimeUp:
-        held = {}
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
     callables = sorted(k for k, v in namespace.items() if callable(v) and k[:2] != "__")
     first = [k for k in graded if k in callables]  # the grader keeps MAX_NAMES: graded ones first
     send({"ready": first + [k for k in callables if k not in first],
-          "foreign": own_code.foreign(namespace, graded), "held": held})
+          "foreign": own_code.foreign(namespace, graded)})
     handles = []
     for line in requests:
         request = json.loads(line)
@@ -185,7 +168,7 @@ class Worker:
     grades; `limit`: seconds for the checks (every call), applied from outside the student's
     process: it is then killed, whatever it does with its signals. After start(): errors
     (cells that raised), notes (what went wrong on the way), names, foreign (graded names not
-    written in the notebook), held ({fingerprint: function name} of the code it holds)."""
+    written in the notebook)."""
 
     def __init__(self, cells, sandbox, exercise=None, graded=(), limit=CALL_LIMIT,
                  timeout=STARTUP_LIMIT):
@@ -194,7 +177,8 @@ class Worker:
         self.setup = {"cells": cells, "graded": self.graded, "timeout": float(timeout)}
         self.limit, self.timeout, self.deadline = limit, timeout, None
         self.process, self.names, self.errors, self.notes = None, [], [], []
-        self.foreign, self.held, self._buffer = {}, {}, b""
+        self.foreign, self._buffer = {}, b""
+        self.stopped, self._cpu = False, 0.0  # stopped: a call the checks' time limit ended
 
     def start(self):
         """Run the cells; raises ProcessEnded when the job did not get to its checks (the notes
@@ -219,9 +203,10 @@ class Worker:
                     continue
                 if "ready" in message:
                     break
-                if "error" in message and len(self.errors) < MAX_NOTES:
+                full = len(self.errors) + len(self.notes) >= MAX_NOTES  # bounded on arrival
+                if "error" in message and not full:
                     self.errors.append(str(message["error"])[:400])
-                if "stopped" in message:
+                if "stopped" in message and not full:
                     self.notes.append(f"cell {str(message['stopped'])[:20]} did not finish "
                                       "within the notebook's time limit "
                                       f"({self.timeout:g} s): it was stopped there")
@@ -234,9 +219,6 @@ class Worker:
         foreign = message.get("foreign", {})
         self.foreign = {k: str(v)[:400] for k, v in foreign.items()
                         if k in self.graded} if isinstance(foreign, dict) else {}
-        held = message.get("held", {})
-        self.held = {str(k)[:64]: str(v)[:80] for k, v in list(held.items())[:MAX_HELD]} \
-            if isinstance(held, dict) else {}
         return self
 
     def _write(self, message):
@@ -246,9 +228,9 @@ class Worker:
         """The job's next message (one JSON line), waiting at most `timeout` s and never past
         the deadline (of the cells or of the checks: `during`)."""
         fd = self.process.fileno()
-        while b"\n" not in self._buffer:
+        while b"\n" not in self._buffer or self.deadline < time.monotonic():
             left = self.deadline - time.monotonic()
-            ready, _, _ = select.select([fd], [], [], max(0.0, min(timeout, left)))
+            ready = left > 0 and select.select([fd], [], [], min(max(timeout, 0.0), left))[0]
             if not ready:
                 if left <= timeout and during == "cells":
                     raise ProcessEnded("it did not finish within the notebook's time limit "
@@ -281,7 +263,8 @@ class Worker:
         try:                                    # (a JAX tracer) leaves the worker running
             self._write(request)
             reply = self._read(CALL_LIMIT)
-        except BaseException:  # a time limit, or a broken worker: end it, it may be busy
+        except BaseException as exc:  # a time limit, or a broken worker: end it, it may be busy
+            self.stopped = self.stopped or not isinstance(exc, Exception)
             self.end()
             raise
         if not isinstance(reply, dict):
@@ -291,13 +274,45 @@ class Worker:
             return decode(reply["value"], call=self.call)
         raised = reply.get("raise") if isinstance(reply.get("raise"), dict) else {}
         if raised.get("kind") == "stop":
-            raise StopSolve(raised.get("message", ""))
+            raise StopSolve(str(raised.get("message", ""))[:200])
         if raised.get("kind") == "not yet":
             raise NotImplementedError
-        error = type(str(raised.get("type", "Error")) or "Error", (Exception,), {})(
-            str(raised.get("message", "")))
+        error = type(str(raised.get("type", "Error"))[:80] or "Error", (Exception,), {})(
+            str(raised.get("message", ""))[:300])
         error.student_line = str(raised.get("line", ""))[:300]
         raise error
+
+    def held(self):
+        """{fingerprint: function name} of the code the cells' source defines, computed in a job
+        of its own, where no student code has run (the notebook's own job could forge it); {}
+        where that job fails. Call it before start(): a fork server runs one job at a time."""
+        from .servers import server_for
+
+        job = server_for(self.sandbox, self.exercise).job(
+            "fingerprints", HELD_LIMIT + GRACE, {"cells": self.cells})
+        found, data, deadline = {}, b"", time.monotonic() + HELD_LIMIT + GRACE
+        try:
+            while not data.endswith(b"\n") and len(data) < MAX_REPLY:
+                left = max(0.0, deadline - time.monotonic())
+                if not select.select([job.fileno()], [], [], left)[0]:
+                    break
+                chunk = os.read(job.fileno(), 1 << 20)
+                if not chunk:
+                    break
+                data += chunk
+            found = json.loads(data) if data.endswith(b"\n") else {}
+        except ValueError:
+            pass
+        finally:
+            job.end()
+        return {str(k)[:64]: str(v)[:80] for k, v in list(found.items())[:MAX_HELD]} \
+            if isinstance(found, dict) else {}
+
+    def cpu_seconds(self):
+        """CPU seconds the job's sandbox has used so far (what the checks' limits count)."""
+        if self.process is not None:
+            self._cpu = self.process.server.process.cpu_seconds()
+        return self._cpu
 
     def function(self, name):
         return functools.wraps(_handle_doc)(lambda *args: self.call(name, args))

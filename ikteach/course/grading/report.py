@@ -30,14 +30,20 @@ def labels(students):
     another folder has the same NFC (then the raw name with every non-ASCII character escaped,
     so that the rows differ visibly); names that still look alike (a folder literally named
     `M\\xfcller` beside one whose name is the Latin-1 bytes) or differ only in case (one
-    feedback file on macOS or Windows) get a short hash of the folder's own bytes."""
+    feedback file on macOS or Windows) get a short hash of the folder's own bytes, again while
+    any two still clash (a folder named as another's hashed label)."""
     shown = {s: unicodedata.normalize("NFC", text(s)) for s in students}
     clashes = {n for n in shown.values() if list(shown.values()).count(n) > 1}
     shown = {s: (text(s).encode("ascii", "backslashreplace").decode() if n in clashes else n)
              for s, n in shown.items()}
-    folded = [n.casefold() for n in shown.values()]
-    return {s: (f"{n} [{hashlib.sha256(os.fsencode(s)).hexdigest()[:8]}]"
-                if folded.count(n.casefold()) > 1 else n) for s, n in shown.items()}
+    digits = 8
+    while True:  # until unique: a folder may be named as another's hashed label
+        folded = [n.casefold() for n in shown.values()]
+        if len(set(folded)) == len(folded):
+            return shown
+        shown = {s: (f"{n} [{hashlib.sha256(os.fsencode(s)).hexdigest()[:digits]}]"
+                     if folded.count(n.casefold()) > 1 else n) for s, n in shown.items()}
+        digits = 64  # the whole hash from the second round: no crafted clash of 8 digits
 
 
 def file_name(label):
@@ -53,7 +59,7 @@ def file_name(label):
 
 def _feedback_text(student, results):
     lines = [f"Feedback for {student}", ""]
-    by_number = {r["exercise"]: r for r in results if r["exercise"] is not None}
+    by_number = _best(results)  # the CSV's choice
     for number in EXERCISE_NUMBERS:
         r = by_number.get(number)
         if r is None:
@@ -62,6 +68,9 @@ def _feedback_text(student, results):
         how = (f", taken as exercise {number} {r['how']}"
                if r.get("how") not in (None, "by its metadata") else "")
         lines.append(f"Exercise {number} ({r['file']}{how}): {r['score']:g}/{r['max']:g}")
+        lines += [f"  not counted (the best notebook counts): {o['file']}: {o['score']:g}/"
+                  f"{o['max']:g} - {o['message'].splitlines()[0][:200] if o['message'] else ''}"
+                  for o in results if o["exercise"] == number and o is not r]
         for line in r["message"].splitlines():
             lines.append(f"  {line}")
         for note in r["notes"]:
