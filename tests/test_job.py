@@ -388,3 +388,48 @@ def test_an_ordinary_user_without_a_cpu_share_grades_one_notebook_at_a_time():
     jobs, why = grade.jobs_for(SimpleNamespace(controlled={"pids"}), 2)
     assert jobs == 1 and "no CPU share per sandbox" in why
     assert grade.jobs_for(SimpleNamespace(controlled=set()), 1) == (1, None)
+
+
+HOSTILE = "x\x1b]0;x\x07\x1b[2J\nz_control\u2215 0\u2215 10\u202eevil"  # title, clear, a fake line
+
+
+def test_no_name_reaches_the_log_csv_or_feedback_with_a_control_or_bidi_character(
+        tmp_path, monkeypatch):
+    """Issue 50 item 5: a folder and a notebook named with ESC sequences, BEL, a newline and
+    U+202E, beside a folder named as their escaped text: every log line, CSV cell, feedback
+    file name and feedback line is printable, and each folder keeps a row and file of its own.
+    The notebook is no JSON, so nothing reaches a sandbox (none is started here)."""
+    import csv
+    import re
+
+    from ikteach.course.grading import sandbox, selfcheck
+    from ikteach.course.grading.submissions import UNSAFE, text
+
+    class Unused:  # the grader's sandbox and self-check: no notebook here gets that far
+        unsandboxed, backend, controlled = False, "none", set()
+        verify = close = lambda self: None
+
+        def __init__(self, *args, **kwargs):
+            pass
+
+        def report(self):
+            return [], []
+
+    monkeypatch.setattr(sandbox, "Sandbox", Unused)
+    monkeypatch.setattr(selfcheck, "run", lambda *args: None)
+    subs, log = tmp_path / "subs", []
+    for folder in (HOSTILE, text(HOSTILE), "anna"):
+        (subs / folder).mkdir(parents=True)
+        (subs / folder / f"02_jt_step{HOSTILE}.ipynb").write_text("{not json")
+    rows = grade.grade_all(subs, tmp_path / "out" / "grades.csv", log=log.append)
+    unsafe = re.compile(f"[{UNSAFE}\n]")
+    feedback = list((tmp_path / "out" / "feedback").iterdir())
+    with open(tmp_path / "out" / "grades.csv", newline="", encoding="utf-8") as handle:
+        cells = [value for row in csv.reader(handle) for value in row]
+    pages = [line for page in feedback for line in page.read_text().splitlines()]
+    names = [page.name for page in feedback]
+    assert len(log) > 3 and not [s for s in log + cells + pages + names if unsafe.search(s)]
+    assert len({row["student"] for row in rows}) == len(feedback) == 3
+    graded = {line.rsplit(" (", 1)[0] for line in log}
+    assert {f"{row['student']}/02_jt_step{text(HOSTILE)}.ipynb: 0/10 not graded"
+            for row in rows} <= graded, log

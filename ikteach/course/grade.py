@@ -61,7 +61,7 @@ from multiprocessing import get_context
 from pathlib import Path
 
 from .exercises import ANSWER_PLACEHOLDER
-from .grading.report import EXERCISE_NUMBERS, POINTS, write_results
+from .grading.report import EXERCISE_NUMBERS, POINTS, labels, write_results
 from .grading.submissions import MAX_NOTEBOOK_BYTES, notebooks, read_notebook, students, text
 
 NOTEBOOK_TIMEOUT = 120.0  # seconds for all of a student's cells
@@ -368,11 +368,12 @@ def grade_all(submissions, out, feedback=None, timeout=NOTEBOOK_TIMEOUT, jobs=1,
         sandbox.close()
     if collect is not None:
         collect.extend(outcomes)
+    shown = labels(per_student)  # as the CSV shows them: printable, one per folder
     for (student, path, problem), result in zip(jobs_list, outcomes):
         per_student[student].append(result)
         if problem or result["status"] == "not graded":
             notes[student].append(f"{result['file']}: {result['message']}")
-        log(f"{text(student)}/{result['file']}: {result['score']:g}/{result['max']:g} "
+        log(f"{shown[student]}/{result['file']}: {result['score']:g}/{result['max']:g} "
             f"{result['status']} ({result.get('seconds', 0.0):.0f} s)")
     return write_results(per_student, notes, out, feedback, sandbox.backend)
 

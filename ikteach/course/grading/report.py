@@ -1,7 +1,8 @@
 """The grader's outputs: one CSV row per student (ex1..ex7, total, the sandbox it ran in, notes:
 why a notebook was not graded, copied: graded code that is ikteach's own answer, for the
-instructor to judge) and one feedback file per student. Every text is printable UTF-8
-(grading/submissions.text), whatever the file names and notebooks held; no CSV cell starts a
+instructor to judge) and one feedback file per student. Every text is printable UTF-8, no
+control or bidi character in it (grading/submissions.text; the feedback keeps its newlines),
+whatever the file names and notebooks held; no CSV cell starts a
 spreadsheet formula; each student's name is NFC-normalised, or written with escapes where two
 names differ only in normalisation, and with a hash of the folder's bytes where two still look
 alike (labels()): every folder its own row and feedback file; a feedback file name is short
@@ -89,7 +90,7 @@ def _feedback_text(student, results):
             lines.append(f"{r['file']}: {r['message']}")
     total = sum(r["score"] for r in by_number.values())
     lines += ["", f"Total: {total:g}/{POINTS * len(EXERCISE_NUMBERS)}"]
-    return text("\n".join(lines) + "\n")
+    return "\n".join(lines) + "\n"
 
 
 def _best(results):
@@ -119,7 +120,8 @@ def write_results(per_student, notes, out, feedback, backend):
         page = _feedback_text(row["student"], results)
         if notes[student] and not results:
             page += "".join(f"note: {n}\n" for n in notes[student])
-        (feedback / file_name(row["student"])).write_text(page, encoding="utf-8")
+        (feedback / file_name(row["student"])).write_text(text(page, lines=True),
+                                                          encoding="utf-8")
     out.parent.mkdir(parents=True, exist_ok=True)
     with open(out, "w", newline="", encoding="utf-8") as handle:
         writer = csv.DictWriter(handle, fieldnames=["student"] + [f"ex{n}" for n in

@@ -4,24 +4,33 @@ Only directories are student folders and only regular files are notebooks: a sym
 a FIFO, a device or a directory named like a notebook is never opened (its student gets 0 and
 the reason). A notebook is read with O_NOFOLLOW | O_NONBLOCK, at most MAX_NOTEBOOK_BYTES, and
 must be JSON nested at most MAX_DEPTH deep. Any file name (not UTF-8) and any text (lone
-surrogates) is turned into printable UTF-8 before it reaches the CSV, the feedback or the log.
+surrogates, control and bidi characters) is turned into printable UTF-8 before it reaches the
+CSV, the feedback, its file name or the log (text()).
 """
 import json
 import os
+import re
 import stat
 
 MAX_NOTEBOOK_BYTES = 20 << 20
 MAX_DEPTH = 64  # a notebook nests about 6 deep; widget state a few more
 
 
-def text(value):
-    """Printable UTF-8 of any str: undecodable bytes of a file name as \\xNN, lone surrogates
-    as \\udNNN."""
+# C0 and C1 controls (ESC, BEL, CR, NEL...), line and paragraph separators, Bidi_Control (U+202E)
+UNSAFE = "\x00-\x09\x0b-\x1f\x7f-\x9f\u2028\u2029\u061c\u200e\u200f\u202a-\u202e\u2066-\u2069"
+_UNSAFE = {False: re.compile(f"[{UNSAFE}\n]"), True: re.compile(f"[{UNSAFE}]")}
+
+
+def text(value, lines=False):
+    """Printable UTF-8 of any str, to show on a terminal or in a file: undecodable bytes of a
+    file name as \\xNN, lone surrogates as \\udNNN, control and bidi characters escaped
+    (\\x1b, \\n, \\u202e), newlines kept only where `lines` (a multi-line text)."""
     value = str(value)
     try:
-        return os.fsencode(value).decode("utf-8", "backslashreplace")
+        value = os.fsencode(value).decode("utf-8", "backslashreplace")
     except UnicodeEncodeError:  # a lone surrogate that was never a byte
-        return value.encode("utf-8", "backslashreplace").decode("utf-8")
+        value = value.encode("utf-8", "backslashreplace").decode("utf-8")
+    return _UNSAFE[lines].sub(lambda m: m.group().encode("unicode_escape").decode(), value)
 
 
 def _kind(mode):
