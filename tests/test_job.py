@@ -390,6 +390,20 @@ def test_an_ordinary_user_without_a_cpu_share_grades_one_notebook_at_a_time():
     assert grade.jobs_for(SimpleNamespace(controlled=set()), 1) == (1, None)
 
 
+def test_the_grader_s_cgroups_are_removed_when_it_ends():
+    """Issue 50 item 6: closing a sandbox (grade_all does when it ends) stops this process's
+    fork servers of it and removes the cgroups made for them (as root: pids, memory, cpu)."""
+    box = Sandbox([]) if SANDBOXED else Sandbox([], unsandboxed=True)
+    try:
+        server = servers.server_for(box, 2)
+        made = list(server.process.cgroups)
+        assert len(made) == len(box.cgroups) and all(c.is_dir() for c in made), made
+    finally:
+        box.close()
+    assert server.process.proc.poll() is not None
+    assert not [c for c in made if c.exists()], made
+
+
 HOSTILE = "x\x1b]0;x\x07\x1b[2J\nz_control\u2215 0\u2215 10\u202eevil"  # title, clear, a fake line
 
 

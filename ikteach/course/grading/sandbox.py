@@ -148,6 +148,11 @@ class Sandbox:
         return "bubblewrap" if self.bwrap else f"none ({OVERRIDE})"
 
     def close(self):
+        """Stop this process's fork servers of this sandbox (their cgroups removed), then
+        remove its folder."""
+        from .servers import close_all
+
+        close_all(self)
         shutil.rmtree(self.work_root, ignore_errors=True)
 
     def verify(self):
@@ -383,25 +388,27 @@ class Process:
             os.killpg(self.proc.pid, signal.SIGKILL)
         except (ProcessLookupError, PermissionError):
             pass
-        for cgroup in self.cgroups:  # unsandboxed: what left the process group (setsid)
-            for _ in range(50):
+        try:
+            self.proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            pass
+        deadline = time.monotonic() + 10
+        for cgroup in self.cgroups:  # removed once empty (unsandboxed: what left by setsid)
+            while time.monotonic() < deadline:
+                try:
+                    cgroup.rmdir()
+                    break
+                except FileNotFoundError:
+                    break
+                except OSError:  # busy: processes still dying, or ones that left the group
+                    pass
                 try:
                     pids = (cgroup / "cgroup.procs").read_text().split()
                 except OSError:
-                    break
-                if not pids:
-                    break
+                    pids = []
                 for pid in pids:
                     try:
                         os.kill(int(pid), signal.SIGKILL)
                     except (ProcessLookupError, PermissionError):
                         pass
                 time.sleep(0.02)
-            try:
-                cgroup.rmdir()
-            except OSError:
-                pass
-        try:
-            self.proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            pass

@@ -42,10 +42,10 @@ def server_for(sandbox, exercise=None):
     return server
 
 
-def close_all():
-    for server in list(_servers.values()):
-        server.stop()
-    _servers.clear()
+def close_all(sandbox=None):
+    """Stop this process's servers (of `sandbox`; None: all)."""
+    for key in [k for k in _servers if sandbox is None or k[0] == str(sandbox.work_root)]:
+        _servers.pop(key).stop()
 
 
 atexit.register(close_all)
