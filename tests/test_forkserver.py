@@ -1,8 +1,9 @@
 """The fork server (ikteach/course/grading/forkserver.py) starts every notebook's run and checks
 in a fresh child of one long-lived process per sandbox: what one notebook does must not reach
 the next one's state or mark. A notebook that writes files (its HOME, TMPDIR, working folder,
-/tmp, /dev/shm, /dev), leaves a daemon (setsid + fork), patches numpy, sets an environment
-variable and makes a SysV shared memory segment is graded; then a plain correct one in the same
+the server's folder around it, /tmp, /dev/shm, /dev), leaves a daemon (setsid + fork), patches
+numpy, sets an environment variable, makes a SysV shared memory segment and changes /tmp's mode
+or the server folder's ACL is graded; then a plain correct one in the same
 sandbox gets 10/10 and a worker of the same server sees none of it.
 
 With bubblewrap all of it holds. Without it (--no-sandbox: no namespaces) the shared places
@@ -27,10 +28,11 @@ def _sandbox():
 
 SHARED = ["/tmp", "/dev/shm", "/dev"]
 ATTACK = '''\
-import ctypes, os, subprocess, sys
+import ctypes, os, struct, subprocess, sys
 import numpy as np
-def _attack(shared, chmod_tmp):
-    for folder in [os.environ["HOME"], os.environ["TMPDIR"], os.getcwd()] + shared:
+def _attack(shared, change):
+    here = [os.environ["HOME"], os.environ["TMPDIR"], os.getcwd(), os.path.dirname(os.getcwd())]
+    for folder in here + shared:  # the job's folder's parent: the server's, writable beneath /tmp
         try:
             with open(os.path.join(folder, "left-by-A"), "w") as handle:
                 handle.write("A")
@@ -46,15 +48,20 @@ def _attack(shared, chmod_tmp):
     np.asarray = lambda a, *args, **kwargs: np.zeros_like(np.array(a, dtype=float))
     if shared:
         ctypes.CDLL(None).shmget(0x1EE7, 4096, 0o1666)
-    if chmod_tmp:
+    if change == "mode":
         os.chmod("/tmp", 0o700)  # cannot be put back by removing files: a fresh server
+    elif change == "acl":  # a default ACL (an xattr) on the server's folder, the job's parent
+        acl = struct.pack("<I", 2) + b"".join(struct.pack("<HHI", tag, 7, 0xFFFFFFFF)
+                                               for tag in (1, 4, 0x20))
+        os.setxattr(os.path.dirname(os.getcwd()), "system.posix_acl_default", acl)
     return True
 '''
 LOOK = '''\
 import os
 import numpy as np
 def look(shared):
-    places = [os.environ["HOME"], os.environ["TMPDIR"], os.getcwd()] + shared
+    places = [os.environ["HOME"], os.environ["TMPDIR"], os.getcwd(),
+              os.path.dirname(os.getcwd())] + shared
     procs = []
     for pid in filter(str.isdigit, os.listdir("/proc")):
         try:
@@ -79,25 +86,25 @@ def jt_step(J, e):
 """  # numpy's asarray, which the attack replaces
 
 
-def attacked_book(shared, chmod_tmp):
+def attacked_book(shared, change):
     """Exercise 2's known-good answer, preceded by the attack (in the cells and the checks)."""
     book = selfcheck.book(GOOD)
-    call = f"_done = _attack({shared!r}, {chmod_tmp!r})\n"
+    call = f"_done = _attack({shared!r}, {change!r})\n"
     book["cells"].insert(1, dict(book["cells"][0], source=ATTACK + call))
     return book
 
 
-# chmod of /tmp only inside a sandbox (without one, /tmp is the machine's own)
-@pytest.mark.parametrize("chmod_tmp", [False, True] if shutil.which("bwrap") else [False])
-def test_what_a_notebook_leaves_does_not_reach_the_next(chmod_tmp):
+# /tmp's mode and the server folder's ACL only inside a sandbox (without one: the machine's own)
+@pytest.mark.parametrize("change", [None, "mode", "acl"] if shutil.which("bwrap") else [None])
+def test_what_a_notebook_leaves_does_not_reach_the_next(change):
     sandbox = _sandbox()
     shared = SHARED if sandbox.bwrap else []
-    if chmod_tmp and not sandbox.bwrap:
+    if change and not sandbox.bwrap:
         sandbox.close()
         pytest.skip("without a sandbox /tmp is the machine's own")
     try:
         first = servers.server_for(sandbox, 2)  # exercise 2's (its copy of ikteach)
-        attacked = grade.grade_book("a.ipynb", attacked_book(shared, chmod_tmp), 30, 60, sandbox)
+        attacked = grade.grade_book("a.ipynb", attacked_book(shared, change), 30, 60, sandbox)
         assert attacked["notes"] == [] and attacked["score"] < 10, attacked  # its own asarray
         replaced = servers.server_for(sandbox, 2) is not first
         after = grade.grade_book("b.ipynb", selfcheck.book(GOOD), 30, 60, sandbox)
@@ -111,8 +118,9 @@ def test_what_a_notebook_leaves_does_not_reach_the_next(chmod_tmp):
                         "tmp": seen["tmp"]}, seen
         if sandbox.bwrap:
             assert seen["tmp"] != oct(0o700), seen
-            # /tmp's mode cannot be put back by removing files: that server was replaced
-            assert replaced == chmod_tmp
+            # /tmp's mode, an xattr (ACL) on the server's folder: not put back by removing
+            # files (Landlock governs no metadata): that server was replaced
+            assert replaced == bool(change)
     finally:
         servers.close_all()
         sandbox.close()

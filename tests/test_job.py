@@ -132,6 +132,16 @@ def seen():
                 out[name] = "locked"
             except OSError as exc:
                 out[name] = exc.strerror
+    st = os.stat(sys.prefix)  # metadata, which Landlock does not govern: left as it was
+    for name, change in [("chmod", lambda: os.chmod(sys.prefix, st.st_mode & 0o7777)),
+                         ("utime", lambda: os.utime(sys.prefix, ns=(st.st_atime_ns,
+                                                                    st.st_mtime_ns))),
+                         ("xattr", lambda: os.setxattr(sys.prefix, "user.ikteach", b"1"))]:
+        try:
+            change()
+            out[name] = "changed"
+        except OSError as exc:
+            out[name] = exc.strerror
     return out
 """
 
@@ -139,7 +149,8 @@ def seen():
 @pytest.mark.skipif(not SANDBOXED, reason="only the sandbox stops it (the refusal is tested)")
 def test_nothing_of_the_kernel_is_writable_and_no_lock_is_shared(sandbox):
     """As root with bubblewrap (this machine, CI): /proc/sys and the job's own oom_score_adj do
-    not open for writing, and a lock on a file all sandboxes see is refused."""
+    not open for writing, a lock on a file all sandboxes see is refused, and the mode, times
+    and extended attributes of the grader's Python (the sandbox's uid may own it) stay."""
     worker = Worker([(1, SEEN)], sandbox, exercise=2).start()
     try:
         seen = worker.call("seen", [])
@@ -147,6 +158,7 @@ def test_nothing_of_the_kernel_is_writable_and_no_lock_is_shared(sandbox):
         worker.end()
     assert all(v != "opened for writing" for v in seen.values()), seen
     assert seen["lockf"] != "locked" and seen["flock"] != "locked", seen
+    assert {seen[n] for n in ("chmod", "utime", "xattr")} == {"Read-only file system"}, seen
     assert os.geteuid() != 0 or seen["/proc/sys/kernel/core_pattern"] in (
         "Read-only file system", "Permission denied"), seen
 

@@ -16,12 +16,12 @@ grader says so, or its time limit passes) the server, as PID 1, kills every othe
 the namespace (kill(-1): daemons, setsid, fork storms), reaps them, removes the job's folder,
 whatever appeared in the sandbox's writable /tmp and /dev, and SysV IPC objects; if anything
 there that existed before was changed (a /dev node replaced, /tmp's mode, an extended attribute
-or ACL there or on the server's folder), or its own limits,
+or ACL there or on the server's folder: Landlock governs no metadata), or its own limits,
 priority, CPU set or OOM score are not those it started with (a job may `prlimit` its server:
 same uid), it says `dirty` and the grader starts a fresh server: every job starts with the
 limits the grader set from outside. In the sandbox a job's child may write only beneath its
-folder, /tmp, /dev/shm and /dev's devices (Landlock, where the kernel has it: no /proc or /sys
-file, e.g. its own oom_score_adj or the kernel's settings, opens for writing). The server is
+folder, /tmp (the server's folder too, where it lies there), /dev/shm and /dev's devices
+(Landlock, where the kernel has it: not its own oom_score_adj or /proc/sys). The server is
 not dumpable (no ptrace, no /proc/1/mem) and, as init, ignores every signal from inside the
 namespace that it has no handler for.
 

@@ -26,6 +26,7 @@ everything of a job killed and removed when it ends; a server a job changed is r
 `Sandbox.verify()` runs a probe as such a job and `report()` states only what the probe saw
 hold.
 """
+import contextlib
 import dataclasses
 import json
 import os
@@ -394,21 +395,12 @@ class Process:
             pass
         deadline = time.monotonic() + 10
         for cgroup in self.cgroups:  # removed once empty (unsandboxed: what left by setsid)
-            while time.monotonic() < deadline:
+            while cgroup.exists() and time.monotonic() < deadline:
                 try:
                     cgroup.rmdir()
-                    break
-                except FileNotFoundError:
-                    break
                 except OSError:  # busy: processes still dying, or ones that left the group
-                    pass
-                try:
-                    pids = (cgroup / "cgroup.procs").read_text().split()
-                except OSError:
-                    pids = []
-                for pid in pids:
-                    try:
-                        os.kill(int(pid), signal.SIGKILL)
-                    except (ProcessLookupError, PermissionError):
-                        pass
-                time.sleep(0.02)
+                    with contextlib.suppress(OSError):
+                        for pid in (cgroup / "cgroup.procs").read_text().split():
+                            with contextlib.suppress(OSError):
+                                os.kill(int(pid), signal.SIGKILL)
+                    time.sleep(0.02)
