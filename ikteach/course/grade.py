@@ -9,7 +9,7 @@
 SUBMISSIONS_DIR holds one folder per student (the folder name is the student), each with that
 student's exercise notebooks. A notebook is taken for an exercise by its content (the
 functions it defines, the check it calls), else its metadata, else an NN_ in its name
-(identify()).
+(grading/recognise.py).
 Each notebook is one job, in a sandbox (ikteach.course.grading.sandbox: bubblewrap, an
 unprivileged user without capabilities, no network, a read-only whitelist of the machine,
 resource limits; where no sandbox works the grader refuses unless --no-sandbox):
@@ -52,7 +52,6 @@ import collections
 import dataclasses
 import functools
 import os
-import re
 import secrets
 import sys
 import time
@@ -61,74 +60,18 @@ from multiprocessing import get_context
 from pathlib import Path
 
 from .exercises import ANSWER_PLACEHOLDER
-from .grading.report import EXERCISE_NUMBERS, POINTS, labels, write_results
+from .grading.recognise import exercise_number, identify  # noqa: F401 (grade.identify)
+from .grading.report import EXERCISE_NUMBERS, POINTS, RERUN, labels, write_results
 from .grading.submissions import MAX_NOTEBOOK_BYTES, notebooks, read_notebook, students, text
 
 NOTEBOOK_TIMEOUT = 120.0  # seconds for all of a student's cells
 GRADE_TIMEOUT = 180.0     # seconds for a notebook's checks: every call
 GRACE = 15.0              # the fork server's kill comes first; then the grader ends it all
 MAX_NOTEBOOKS = 3 * 7      # notebooks graded per student (the rest: a note)
-RERUN = ("a check ran past its time limit and was run again in a fresh sandbox: the marks "
-         "are the second run's")
 INSTRUCTOR = Path(__file__).resolve().parents[2] / "instructor"  # the solutions: hidden
 
 __all__ = ["grade_all", "grade_notebook", "grade_book", "exercise_number", "main",
            "MAX_NOTEBOOK_BYTES"]
-
-
-def _from_name(path):
-    """The exercise a file's name gives: its first NN_ that is an exercise's number (so Colab's
-    "Copy of 02_jt_step.ipynb" and a download's "02_jt_step (1).ipynb" are exercise 2)."""
-    for match in re.finditer(r"(?<!\d)(\d+)_", Path(path).name):
-        if int(match.group(1)) in EXERCISE_NUMBERS:
-            return int(match.group(1))
-    return None
-
-
-def _from_content(book):
-    """(exercise, why) from what the code cells define and check - every graded function of
-    exactly one exercise defined, or one exercise's check called; (None, None) otherwise.
-    Regular expressions on the text (linear: nothing here parses a student's code)."""
-    from . import check
-    from .grading.extract import code_cells
-
-    source = "\n".join(text_ for _, text_ in code_cells(book))
-    defined = set(re.findall(r"^def[ \t]+(\w+)[ \t]*\(", source, re.M))
-    checked = set(re.findall(r"^[ \t]*ik\.check\.(\w+)[ \t]*\(", source, re.M))
-    found = [n for n, m in check.EXERCISES.items() if set(m.FUNCTIONS) <= defined]
-    if len(found) > 1:  # several exercises' names defined: the one whose check is called
-        found = [n for n in found if check.EXERCISES[n].CHECK_NAME in checked] or found
-    if len(found) == 1:
-        names = ", ".join(f"`{f}`" for f in check.EXERCISES[found[0]].FUNCTIONS)
-        return found[0], f"by its content (it defines {names})"
-    called = [n for n, m in check.EXERCISES.items() if m.CHECK_NAME in checked]
-    if len(called) == 1:
-        return called[0], ("by its content (it calls "
-                           f"ik.check.{check.EXERCISES[called[0]].CHECK_NAME})")
-    return None, None
-
-
-def identify(path, book):
-    """(exercise number or None, how it was recognised): its content (the functions it
-    defines, the check it calls), else the notebook's metadata (ikteach.exercise: a student
-    who started exercise 3 from the exercise 2 file keeps exercise 2's), else an NN_ in its
-    file name."""
-    meta = book.get("metadata") if isinstance(book, dict) else None
-    meta = meta.get("ikteach") if isinstance(meta, dict) else None
-    said = meta.get("exercise") if isinstance(meta, dict) else None
-    said = said if isinstance(said, int) and said in EXERCISE_NUMBERS else None
-    number, why = _from_content(book) if isinstance(book, dict) else (None, None)
-    if number is not None and number != said:
-        return number, why + (f"; its metadata says exercise {said}" if said else "")
-    if said is not None:
-        return said, "by its metadata"
-    number = _from_name(path)
-    return (number, "by its file name") if number is not None else (None, None)
-
-
-def exercise_number(path, book):
-    """The exercise a notebook answers (identify()'s number)."""
-    return identify(path, book)[0]
 
 
 def _answer_text(book):

@@ -18,6 +18,8 @@ from .submissions import text
 
 FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
 MAX_FILE_NAME = 120  # bytes of a feedback file's name before its hash
+RERUN = ("a check ran past its time limit and was run again in a fresh sandbox: the marks "
+         "are the second run's")
 
 
 def cell(value):

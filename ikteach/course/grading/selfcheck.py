@@ -15,7 +15,7 @@ import ast
 import importlib
 import inspect
 
-from ..grade import RERUN
+from .report import RERUN
 
 EXERCISE = 2
 SETUP = "import numpy as np\nimport ikteach as ik\n"
