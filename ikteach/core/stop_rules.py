@@ -131,11 +131,11 @@ def gains(start, end, visible):
     return jnp.any((fall > visible) & (held_before > 0))
 
 
-def probe(problem, theta, levels, free, lower, upper, sigma_max, slack):
-    """Up to PROBE_STEPS light priority steps from theta, each kept only when it helps
-    (module doc); returns where the probe ends and its level norms. Each step walks the arm
-    once, at its trial point: e and J there are kept with it (a refused trial leaves q, its e
-    and its J as they were)."""
+def probe(problem, theta, e, J, levels, free, lower, upper, sigma_max, slack):
+    """Up to PROBE_STEPS light priority steps from theta (e and J there), each kept only when it
+    helps (module doc); returns where the probe ends, e there and its level norms. Each step walks
+    the arm once, at its trial point: e and J there are kept with it (a refused trial leaves q,
+    its e and its J as they were)."""
     def light_step(e, J, damping):
         J = J * free
         if len(levels) == 1:  # one level: the DLS step (as multilevel_step, without its SVD)
@@ -144,7 +144,6 @@ def probe(problem, theta, levels, free, lower, upper, sigma_max, slack):
             step = multilevel_step([(J[jnp.asarray(r)], e[jnp.asarray(r)]) for r in levels], damping)
         return cap_step(step, PROBE_MAX_TURN)
 
-    e, J = problem.error_and_jacobian(theta)
     start = level_norms(e, levels)
 
     def one(_, carry):
@@ -157,8 +156,8 @@ def probe(problem, theta, levels, free, lower, upper, sigma_max, slack):
         return (keep(trial, q), keep(trial_e, e), keep(trial_J, J), keep(trial_norms, norms),
                 keep(f / PROBE_LIGHTER, f * PROBE_HEAVIER))
 
-    end, _, _, norms, _ = jax.lax.fori_loop(0, PROBE_STEPS, one, (theta, e, J, start, PROBE_DAMPING))
-    return end, norms
+    end, end_e, _, norms, _ = jax.lax.fori_loop(0, PROBE_STEPS, one, (theta, e, J, start, PROBE_DAMPING))
+    return end, end_e, norms
 
 
 def saddle(problem, theta, rows, free, sigma_max):
@@ -176,13 +175,13 @@ def stall_kind(problem, theta, lower, upper, levels, tol):
     """Why a solve stopped small at theta: MINIMUM (out of reach), SADDLE or CUT_SHORT (module
     doc). levels: the error's row indices per priority level, level 0 first (a tuple of
     tuples); tol: the solve's tolerance."""
-    e, J = problem.error(theta), problem.jacobian(theta)
+    e, J = problem.error_and_jacobian(theta)  # one walk of the arm, shared with the probe
     g = J.T @ e
     free = ~(((theta <= lower) & (g < 0)) | ((theta >= upper) & (g > 0)))  # not pushed into a limit
     sigma_max = jnp.linalg.norm(J * free, 2)
     visible = jnp.maximum(IMPROVABLE * jnp.linalg.norm(e), tol)  # smaller changes do not count
-    end, norms = probe(problem, theta, levels, free, lower, upper, sigma_max, visible)
-    gained = gains(level_norms(e, levels), norms, visible) | (jnp.linalg.norm(problem.error(end)) < tol)
+    _, end_e, norms = probe(problem, theta, e, J, levels, free, lower, upper, sigma_max, visible)
+    gained = gains(level_norms(e, levels), norms, visible) | (jnp.linalg.norm(end_e) < tol)
     at_saddle = saddle(problem, theta, levels[0], free, sigma_max)
     return jnp.where(gained, CUT_SHORT, jnp.where(at_saddle, SADDLE, MINIMUM))
 
