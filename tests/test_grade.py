@@ -355,7 +355,7 @@ def test_the_log_and_the_csv_say_what_the_sandbox_enforces(graded):
     backends = {row["sandbox"] for row in graded.rows.values()}
     if SANDBOXED:
         assert "sandbox: bubblewrap; enforced:" in log and backends == {"bubblewrap"}
-        assert "with no capabilities, in its own user namespace (checked at start-up)" in log
+        assert "with no capabilities, in its own user namespace, and as an unprivileged uid outside it" in log
         assert "no network (own network namespace" in log and "WARNING" not in graded.stderr
     else:
         assert backends == {"none (--no-sandbox)"} and "ISOLATION: NONE" in log

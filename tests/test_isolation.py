@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 from ikteach.course import grade
+from ikteach.course.grading import bwrap
 from ikteach.course.grading.remote import MAX_NOTES
 from sandboxes import SANDBOXED
 
@@ -105,7 +106,7 @@ _forged = {"ready": ["x%d" % i for i in range(100000)],
            "held": {"%024d" % i: "z" * 80 for i in range(20000)}}
 os.write(4, (json.dumps(_forged) + "\\n").encode())  # the job's replies pipe
 '''
-USER = 65534  # nobody
+USER = 64999  # an ordinary user: not nobody, whose processes the sandboxes of root's graders are
 
 
 def _with_cell(source):
@@ -118,20 +119,20 @@ def _with_cell(source):
 
 @pytest.fixture(scope="module")
 def graded_as_user():
-    """A class graded by an ordinary user (nobody: no cgroups, RLIMIT_NPROC per user), two
+    """A class graded by an ordinary user (no cgroups, RLIMIT_NPROC per user), two
     notebooks at a time: a fork to the process limit, a prlimit on the fork server, a forged
     first message, and an honest classmate."""
     import os
     import tempfile
-    if not SANDBOXED or os.geteuid() != 0 or not shutil.which("setpriv"):
+    if not SANDBOXED or os.geteuid() != 0:
         pytest.skip("needs root (to become an ordinary user) and bubblewrap")
-    as_user = ["setpriv", f"--reuid={USER}", f"--regid={USER}", "--clear-groups",
-               "--inh-caps=-all"]
+    # where the Python lies under a folder the user cannot enter (/root), it is shown to it
+    as_user = bwrap.reachable(shutil.which("bwrap"), [sys.base_prefix], USER) + [
+        sys.executable, "-S", str(bwrap.LAUNCH), "--as", str(USER), "--"]
     seen = subprocess.run(as_user + [sys.executable, "-S", "-c",
-                                     "import sys; print(sys.base_prefix)"],
+                                     "import os, sys; print(os.getuid(), sys.base_prefix)"],
                           capture_output=True, text=True, timeout=60)
-    if seen.stdout.strip() != sys.base_prefix:  # e.g. a Python installed under /root
-        pytest.skip(f"an ordinary user cannot read this Python ({sys.base_prefix})")
+    assert seen.stdout.split() == [str(USER), sys.base_prefix], seen
     base = Path(tempfile.mkdtemp(prefix="ikteach-as-user-"))  # pytest's folders are root's only
     subs = base / "submissions"
     honest(subs / "zz_honest")  # graded last
@@ -160,5 +161,6 @@ def graded_as_user():
 def test_as_an_ordinary_user_the_classmate_keeps_full_marks(graded_as_user):
     rows, feedback, log = graded_as_user
     assert "at most 256 per sandbox (RLIMIT_NPROC in its user namespace" in log, log
+    assert "as an unprivileged uid outside it" in log and "(checked at start-up)" in log, log
     assert float(rows["zz_honest"]["total"]) == 10.0 * len(HONEST), feedback["zz_honest"]
     assert float(rows["forged"]["total"]) == 0 and len(rows["forged"]["notes"]) < 2000

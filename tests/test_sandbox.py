@@ -93,6 +93,11 @@ ATTACK = """
           libc.mount(None, {package!r}.encode(), None, 32 | 4096, None))
     print("unshare", libc.unshare(0x10000000))
     print("listing after:", os.listdir({check!r}))
+    for dev in ("/dev/null", "/dev/zero", "/dev/full", "/dev/random", "/dev/urandom"):
+        try:  # to the mode it has: a change of nothing, should it succeed
+            os.chmod(dev, os.stat(dev).st_mode & 0o7777); print("chmod", dev)
+        except OSError as exc:
+            print("no chmod", dev, exc.errno)
     """
 
 
@@ -127,6 +132,10 @@ def test_a_student_process_cannot_escape_hide_or_regain_power(sandbox, tmp_path)
     assert "no network" in out and "uid 65534 caps [0]" in out, out
     assert "umount -1" in out and "remount -1 -1" in out and "unshare -1" in out, out
     assert "listing after: []" in out, out
+    # the machine's device nodes are bound in: as their owner (a sandbox of a root grader
+    # that is host root) a job could make /dev/null useless for every user (issue 48)
+    assert not [l for l in out.splitlines() if l.startswith("chmod")], out
+    assert out.count("no chmod /dev/") == 5, out
 
 
 def test_the_probe_catches_a_sandbox_that_does_not_hold(monkeypatch):
@@ -142,15 +151,32 @@ def test_the_probe_catches_a_sandbox_that_does_not_hold(monkeypatch):
         box.close()
 
 
+def test_a_root_grader_starts_the_sandbox_as_nobody(monkeypatch):
+    """As root, bwrap maps the sandbox's uid to root outside unless it starts as another uid:
+    started as root, verify() must refuse (the job owns /dev/null); as nobody, it holds."""
+    if not SANDBOXED or os.geteuid() != 0:
+        return
+    argv = bwrap.unprivileged(["bwrap", "--ro-bind", sys.base_prefix, sys.base_prefix, "--"])
+    assert argv[argv.index("--as") + 1] == bwrap.SANDBOX_ID and argv[-1] == "--", argv
+    monkeypatch.setattr(bwrap, "unprivileged", list)
+    box = Sandbox([])
+    try:
+        with pytest.raises(SandboxUnavailable, match="owns the machine's device nodes"):
+            box.verify()
+    finally:
+        box.close()
+
+
 def test_judge_states_only_what_held():
-    good = {"uid": 65534, "capabilities": 0, "read": [], "connected": False, "mounted": False,
+    good = {"uid": 65534, "capabilities": 0, "devices_owned": False, "read": [], "connected": False, "mounted": False,
             "processes": 2, "userns_blocked": True,
             "server": {"ptrace": False, "memory": False, "stopped": False}}
     lines = bwrap.judge(good, [], [Path("/srv/solutions")])
     assert any("no capabilities" in l for l in lines) and any("PID namespace" in l for l in lines)
     assert not any("user namespaces" in l for l in bwrap.judge(dict(good, userns_blocked=False),
                                                                 [], []))
-    for bad, why in [({"uid": 0}, "uid 0"), ({"capabilities": 1 << 21}, "keeps capabilities"),
+    for bad, why in [({"uid": 0}, "uid 0"), ({"devices_owned": True}, "device nodes"),
+                     ({"devices_owned": None}, "device nodes"), ({"capabilities": 1 << 21}, "keeps capabilities"),
                      ({"read": ["/srv/solutions"]}, "read the hidden /srv/solutions"),
                      ({"mounted": True}, "mount"),
                      ({"server": {"ptrace": True, "memory": False, "stopped": False}},

@@ -4,9 +4,10 @@ start-up probe (probe.py) must have seen for the log to say the sandbox holds.
 A run sees a whitelist, read-only: the system folders (/usr, /lib...), a few files of /etc,
 the grader's Python (prefixes and sys.path folders) and ikteach's package folder; hidden
 folders inside those (the checker, the solutions...) get an empty read-only tmpfs. Its own
-user namespace maps it to an unprivileged uid without capabilities (so a grader running as
-root gives it no power to remount or to read what is laid over), and --disable-userns (where
-this bwrap has it) stops it from making a new user namespace to regain them.
+user namespace maps it to an unprivileged uid without capabilities, and --disable-userns (where
+this bwrap has it) stops it from making a new user namespace to regain them. That namespace's
+uid is, outside, the uid that starts bwrap: a grader run as root starts it as SANDBOX_ID
+(unprivileged()), so that no job owns what root owns, such as the device nodes every sandbox binds.
 """
 import os
 import subprocess
@@ -14,7 +15,8 @@ import sys
 import tempfile
 from pathlib import Path
 
-SANDBOX_ID = "65534"  # uid and gid inside ("nobody")
+SANDBOX_ID = "65534"  # uid and gid inside ("nobody"), and outside when the grader is root
+LAUNCH = Path(__file__).with_name("_launch.py")
 SYSTEM = ("/usr", "/bin", "/sbin", "/lib", "/lib32", "/lib64", "/libx32")
 ETC = ("ld.so.cache", "ld.so.conf", "ld.so.conf.d", "localtime", "timezone", "passwd", "group",
        "nsswitch.conf", "hosts", "host.conf", "alternatives", "fonts", "mime.types",
@@ -108,6 +110,35 @@ def command(bwrap, flags, package, hidden, work, pid1=False, tmpfs_bytes=None, s
     return args + NAMESPACES + (["--as-pid-1"] if pid1 else []) + list(flags) + ["--"]
 
 
+def unprivileged(args):
+    """The bwrap command line `args`, started as host uid SANDBOX_ID when this process is root:
+    a bwrap as root that makes what `args` binds reachable for that uid (reachable()), then
+    the drop (_launch.py --as), then `args`."""
+    if os.geteuid() != 0:
+        return list(args)
+    sources = [args[i + 1] for i, op in enumerate(args[:-1]) if op in ("--ro-bind", "--ro-bind-try")]
+    return (reachable(args[0], sources, int(SANDBOX_ID))
+            + [sys.executable, "-S", str(LAUNCH), "--as", SANDBOX_ID, "--", *args])
+
+
+def reachable(bwrap, sources, uid):
+    """bwrap ... -- (a command follows): as root, a mount namespace where `uid` reaches each
+    of `sources`: a folder it cannot enter on the way (such as /root, or the grader's temporary
+    folder) becomes a tmpfs holding only the paths to those sources."""
+    closed = lambda p: os.stat(p).st_uid != uid and not os.stat(p).st_mode & 0o001  # noqa: E731
+    outer, made = [bwrap, "--dev-bind", "/", "/", "--chdir", "/", "--die-with-parent"], set()
+    for source in map(Path, sources):
+        shut = next((p for p in reversed(source.parents) if closed(p)), None)
+        if shut is None or not source.exists():
+            continue
+        for folder in [shut, *reversed(source.parents[:source.parents.index(shut)])]:
+            if folder not in made:
+                outer += ["--perms", "0755", "--tmpfs" if folder == shut else "--dir", str(folder)]
+                made.add(folder)
+        outer += ["--ro-bind", str(source), str(source)]
+    return outer + ["--"]
+
+
 def private_mounts(tmpfs_bytes):
     """What a run may write besides its working folder, RAM-backed and each at most
     `tmpfs_bytes` (None: no size): /tmp and /dev/shm; /dev itself read-only; POSIX message
@@ -165,8 +196,8 @@ def working_flags(bwrap):
     with tempfile.TemporaryDirectory(prefix="ikteach-bwrap-") as work:
         for flags, sized in VARIANTS:
             fd = seccomp_fd()
-            argv = command(bwrap, flags, package, [], Path(work),
-                           tmpfs_bytes=TRIAL_TMPFS if sized else None, seccomp=fd)
+            argv = unprivileged(command(bwrap, flags, package, [], Path(work),
+                                        tmpfs_bytes=TRIAL_TMPFS if sized else None, seccomp=fd))
             try:
                 run = subprocess.run(argv + [sys.executable, "-S", "-c", ""], capture_output=True,
                                      timeout=30, cwd=work, pass_fds=[fd] if fd else [])
@@ -191,6 +222,9 @@ def judge(seen, escaped, hidden):
     failures = []
     if seen.get("uid") in (0, None):
         failures.append(f"the student's process runs as uid {seen.get('uid')}")
+    if seen.get("devices_owned") is not False:
+        failures.append("the student's process owns the machine's device nodes (it is root "
+                        "outside its namespace): it could chmod /dev/null for every user")
     if seen.get("capabilities") != 0:
         failures.append(f"the student's process keeps capabilities ({seen.get('capabilities')})")
     if escaped:  # seen from here: a write into the run's private /tmp goes nowhere
@@ -209,7 +243,8 @@ def judge(seen, escaped, hidden):
     if failures:
         raise SandboxUnavailable("bubblewrap runs, but its sandbox does not hold: "
                                  + "; ".join(failures) + ".")
-    lines = [f"runs as uid {seen['uid']} with no capabilities, in its own user namespace",
+    lines = [f"runs as uid {seen['uid']} with no capabilities, in its own user namespace, and "
+             "as an unprivileged uid outside it (it owns no device node: chmod /dev/null fails)",
              "cannot mount or remount file systems",
              "no network (own network namespace; the grader's port was unreachable)",
              "no writes outside its working folder (tried the ikteach package, the Python "

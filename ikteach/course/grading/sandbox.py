@@ -5,7 +5,8 @@ Backend: bubblewrap (`bwrap`; Debian/Ubuntu/Fedora/Arch package `bubblewrap`), s
 run sees a read-only whitelist of the machine (system libraries, a few files of /etc, the
 Python the grader runs on, ikteach's package without its checker) and its own working folder;
 /tmp private; no network; own PID, IPC and UTS namespaces; its own user namespace as an
-unprivileged uid with no capabilities, also when the grader runs as root; /proc/sys and the other
+unprivileged uid with no capabilities, and outside it an unprivileged uid too (a grader run as
+root starts bwrap as "nobody"); /proc/sys and the other
 parts of /proc that write to the machine's kernel read-only, and (Landlock, forkserver.py) no
 file outside its folders, /tmp and /dev/shm opens for writing: not its own oom_score_adj.
 What a run writes lives in memory, size-limited (tmpfs: /tmp, /dev/shm, its working folder;
@@ -44,7 +45,6 @@ from .process import Process
 
 __all__ = ["Limits", "Process", "Sandbox", "SandboxUnavailable", "refusal"]
 
-LAUNCH = Path(__file__).with_name("_launch.py")
 CGROUP_FS = Path("/sys/fs/cgroup")
 # a sandbox's cgroup (v1: one per controller; v2: one): {limit file: Limits field}
 CGROUP_LIMITS = {"pids.max": "processes", "memory.limit_in_bytes": "memory_mb",
@@ -310,14 +310,15 @@ class Sandbox:
         copy of ikteach it sees)."""
         lim = self.limits
         nproc = self.outer_nproc()
-        launch = [sys.executable, "-S", str(LAUNCH), str(lim.cpu_seconds),
+        launch = [sys.executable, "-S", str(_bwrap.LAUNCH), str(lim.cpu_seconds),
                   str(lim.memory_mb << 20), str(lim.file_mb << 20), str(nproc),
                   ",".join(map(str, cgroups)) or "-", "--"]
         if not self.bwrap:
             return launch + list(argv)
         tmpfs = lim.tmpfs_mb << 20 if self.sized_tmpfs else None
-        return launch + _bwrap.command(self.bwrap, self.flags, self.package, self.hidden,
-                                       Path(work), pid1, tmpfs, seccomp, package) + list(argv)
+        return launch + _bwrap.unprivileged(_bwrap.command(
+            self.bwrap, self.flags, self.package, self.hidden, Path(work), pid1, tmpfs, seccomp,
+            package) + list(argv))
 
     def environment(self, work, package=None):
         """The bare environment of a run; `package`: the copy of ikteach it imports (without
