@@ -167,6 +167,27 @@ def test_a_root_grader_starts_the_sandbox_as_nobody(monkeypatch):
         box.close()
 
 
+def test_only_a_folder_the_uid_cannot_enter_is_laid_over():
+    """reachable(): nothing to do where every folder on the way lets the uid in (a Python in
+    /usr, a container's root without the right to make mount namespaces still grades); a
+    folder it cannot enter becomes a tmpfs holding the way to each source, and only that."""
+    with tempfile.TemporaryDirectory(dir="/tmp") as base:  # /tmp: every uid enters it
+        _laid_over(Path(base))
+
+
+def _laid_over(base):
+    base.chmod(0o755)
+    shut, source = base / "shut", base / "shut" / "a" / "python"
+    source.mkdir(parents=True)
+    shut.chmod(0o755)
+    assert bwrap.reachable("bwrap", [str(source)], 64999) == []
+    shut.chmod(0o700)
+    argv = bwrap.reachable("bwrap", [str(source)], 64999)
+    assert argv[-1] == "--" and argv[argv.index("--tmpfs") + 1] == str(shut), argv
+    assert argv[argv.index("--dir") + 1] == str(shut / "a"), argv
+    assert argv[argv.index("--ro-bind") + 1:argv.index("--ro-bind") + 3] == [str(source)] * 2
+
+
 def test_judge_states_only_what_held():
     good = {"uid": 65534, "capabilities": 0, "devices_owned": False, "read": [], "connected": False, "mounted": False,
             "processes": 2, "userns_blocked": True,

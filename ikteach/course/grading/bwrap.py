@@ -122,9 +122,9 @@ def unprivileged(args):
 
 
 def reachable(bwrap, sources, uid):
-    """bwrap ... -- (a command follows): as root, a mount namespace where `uid` reaches each
-    of `sources`: a folder it cannot enter on the way (such as /root, or the grader's temporary
-    folder) becomes a tmpfs holding only the paths to those sources."""
+    """[] where `uid` reaches each of `sources`; else bwrap ... -- (a command follows): as
+    root, a mount namespace where a folder it cannot enter on the way (such as /root) is a
+    tmpfs holding only the paths to those sources."""
     closed = lambda p: os.stat(p).st_uid != uid and not os.stat(p).st_mode & 0o001  # noqa: E731
     outer, made = [bwrap, "--dev-bind", "/", "/", "--chdir", "/", "--die-with-parent"], set()
     for source in map(Path, sources):
@@ -136,7 +136,7 @@ def reachable(bwrap, sources, uid):
                 outer += ["--perms", "0755", "--tmpfs" if folder == shut else "--dir", str(folder)]
                 made.add(folder)
         outer += ["--ro-bind", str(source), str(source)]
-    return outer + ["--"]
+    return outer + ["--"] if made else []
 
 
 def private_mounts(tmpfs_bytes):

@@ -124,6 +124,8 @@ class Sandbox:
         self.cgroups = _cgroup_parents()
         self.controlled = set().union(*self.cgroups.values())
         self.root = os.geteuid() == 0
+        if self.root:  # its copies of ikteach are read by the sandbox's uid, not root (bwrap.py)
+            os.chmod(self.work_root, 0o711)
         self.tried, self.verified, self.flags, self.sized_tmpfs = [], [], None, False
         self.bwrap = None
         path = shutil.which("bwrap") if bwrap is None else (bwrap or None)
