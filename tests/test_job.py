@@ -211,6 +211,30 @@ def test_extended_attributes_and_acls_a_job_leaves_do_not_reach_the_next(sandbox
     assert after["score"] == 10 and after["notes"] == [], after
 
 
+LEAVE_TIMES = "import os\nfor _p in ('/tmp', '/dev/shm', '..'):\n    os.utime(_p, ns=(123456789, 987654321))\n"
+SEES_TIMES = ("import os\nassert not {123456789, 987654321} & {t for p in ('/tmp', '/dev/shm', '..') "
+              "for t in (os.stat(p).st_atime_ns, os.stat(p).st_mtime_ns)}\n")
+
+
+@pytest.mark.skipif(not SANDBOXED, reason="only the sandbox stops it (the refusal is tested)")
+def test_times_a_job_sets_do_not_reach_the_next(sandbox):
+    """Round 5: times set on /tmp, /dev/shm and the server's folder (a message of 128 bits
+    each) are put back after the job; the server is kept (times change in every job)."""
+    first = servers.server_for(sandbox, 2)
+    left = grade.grade_book("attack.ipynb", with_cell(LEAVE_TIMES), 60, 120, sandbox, seed=1)
+    assert left["notes"] == [], left
+    after = grade.grade_book("b.ipynb", with_cell(SEES_TIMES), 60, 120, sandbox, seed=1)
+    assert servers.server_for(sandbox, 2) is first
+    assert after["score"] == 10 and after["notes"] == [], after
+
+
+def with_cell(source):
+    book = copy.deepcopy(SOLUTION)
+    book["cells"].insert(1, {"cell_type": "code", "metadata": {}, "outputs": [],
+                             "execution_count": None, "source": source})
+    return book
+
+
 FORGED = """\
 import json, os
 _forged = {"ready": ["x%d" % i for i in range(100000)],
