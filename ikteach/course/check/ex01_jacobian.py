@@ -7,7 +7,7 @@ import numpy as np
 
 from ...core.chain import planar_chain
 from ...core.jacobian import jacobian as _ref_jacobian
-from .verdicts import (_as_array, _call, _Case, _close, _evaluate, _Fail, _fmt, _in_every_draw,
+from .verdicts import (_answers, _Case, _close, _evaluate, _Fail, _fmt, _in_every_draw,
                        _mismatch, _Part, _rng, _shape_message)
 
 NUMBER = 1
@@ -47,11 +47,9 @@ def _jacobian_cases(seed=None):
         n = int(rng.integers(1, 6))
         cases.append((rng.uniform(0.5, 1.5, n).round(3).tolist(),
                       rng.uniform(-np.pi, np.pi, n).round(3).tolist(), "regular"))
-    out = []
-    for k, (lengths, theta, tag) in enumerate(cases):
-        text = f"lengths = {_fmt(lengths)}, theta = {_fmt(theta)}"
-        out.append(_Case((lengths, theta), text, size=len(lengths) * 100 + k, tag=tag))
-    return sorted(out, key=lambda c: c.size)
+    return [_Case((lengths, np.array(theta)), f"lengths = {_fmt(lengths)}, theta = {_fmt(theta)}",
+                  size=len(lengths) * 100 + k, tag=tag)
+            for k, (lengths, theta, tag) in enumerate(cases)]
 
 
 def _jacobian_reference(lengths, theta):
@@ -86,16 +84,10 @@ def _columns_up_to_sign(got, want):
         _close(g, w, scale=scale) or _close(g, -w, scale=scale) for g, w in zip(got.T, want.T))
 
 
-def _jacobian_parts(fn, name, seed=None):
-    cases = _jacobian_cases(seed)
-    cache = {}
-
-    def result(case):
-        if id(case) not in cache:
-            lengths, theta = case.args
-            cache[id(case)] = _as_array(_call(fn, name, case, list(lengths), np.array(theta)),
-                                        name, case)
-        return cache[id(case)]
+def verdict(planar_jacobian, seed=None):
+    """Verdict for exercise 1 without printing (`seed`: the grader's hidden cases)."""
+    name, cases = FUNCTIONS[0], _jacobian_cases(seed)
+    result = _answers(planar_jacobian, name)
 
     def compared(tag):
         """(case, got, want) of the cases with `tag`, shapes checked first."""
@@ -129,10 +121,6 @@ def _jacobian_parts(fn, name, seed=None):
                 return ("at a singular configuration (arm straight or folded): "
                         + _diagnose_jacobian(got, want, case))
 
-    return [_Part("shape", 2, shape), _Part("lever arms", 4, lever_arms),
-            _Part("sign", 2, sign), _Part("singular", 2, singular)]
-
-
-def verdict(planar_jacobian, seed=None):
-    """Verdict for exercise 1 without printing (`seed`: the grader's hidden cases)."""
-    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _jacobian_parts(planar_jacobian, FUNCTIONS[0], seed))
+    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), [
+        _Part("shape", 2, shape), _Part("lever arms", 4, lever_arms), _Part("sign", 2, sign),
+        _Part("singular", 2, singular)])

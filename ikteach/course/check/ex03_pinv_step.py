@@ -7,9 +7,9 @@ guard for sigma_max = 0 (J = 0: nothing is kept) 2.
 import numpy as np
 
 from ...core.pinv import pinv_step as _ref_pinv
-from .verdicts import (_as_array, _call, _Case, _close, _evaluate, _Fail, _fmt, _in_every_draw,
+from .verdicts import (_answers, _Case, _close, _evaluate, _Fail, _fmt, _in_every_draw,
                        _matrix_text, _mismatch, _Part, _random_matrix, _rng, _shape_message,
-                       _turned, _with_singular_values)
+                       _turned_hand, _with_singular_values)
 
 NUMBER = 3
 CHECK_NAME = "pinv_step"
@@ -22,6 +22,8 @@ FIXED_CUTOFFS = tuple(10.0 ** (-k / 4) for k in range(33))  # a step ignoring rc
 SWAP_HINT = ("\n  hint: J (m x n) = U Sigma V^T with U m x k and V n x k: U^T takes e (m entries) "
              "and V gives delta_theta (n entries), delta_theta = V Sigma^+ U^T e. U and V "
              "swapped? (np.linalg.svd returns U, sigma and V^T.)")
+RELATIVE = ("the cut-off must be relative: drop sigma_i < rcond * sigma_max (the largest "
+            "singular value), not sigma_i < rcond.")
 
 
 def _singular_hand(rng):
@@ -54,7 +56,7 @@ def _pinv_cases(seed=None):
                            size=m * n * 100 + 50 + k, tag="regular"))
     singular = _singular_hand(_rng(None, 30))  # the seed's own: the same turned
     if seed is not None:
-        singular = [(*(x[0] for x in _turned(rng, [J], [e])), r) for J, e, r in singular]
+        singular = _turned_hand(rng, singular)
     for k, (J, e, rcond) in enumerate(singular):
         s = np.linalg.svd(J, compute_uv=False)
         cases.append(_Case((J, e, rcond), _matrix_text(J, e, f", rcond = {rcond:g}")
@@ -64,7 +66,7 @@ def _pinv_cases(seed=None):
     J, e = np.zeros((2, n)), np.array([1.0, -0.5]) * (1 if seed is None else rng.normal())
     cases.append(_Case((J, e, 1e-6), _matrix_text(J, e, ", rcond = 1e-06") + " (J = 0: sigma_max = 0)",
                        size=J.size * 100, tag="zero"))
-    return sorted(cases, key=lambda c: c.size)
+    return cases
 
 
 def _pinv_variant(J, e, cut, swapped=False):
@@ -119,28 +121,24 @@ def _diagnose(got, want, case):
                 f"sigma_max; here your step is {np.linalg.norm(got):.3g} long (np.linalg.pinv(J) "
                 "keeps every sigma_i >= 1e-15 sigma_max)." + _mismatch(got, want, case))
     if _close(got, _pinv_variant(J, e, lambda s: s >= rcond)):
-        return ("the cut-off must be relative: drop sigma_i < rcond * sigma_max "
-                "(the largest singular value), not sigma_i < rcond." + _mismatch(got, want, case))
+        return RELATIVE + _mismatch(got, want, case)
     return ("wrong values: delta_theta = sum_i (u_i . e / sigma_i) v_i over the "
             "sigma_i kept by the cut-off." + _mismatch(got, want, case))
 
 
-def _pinv_parts(fn, name, seed=None):
-    cases = _pinv_cases(seed)
-    cache = {}
+def verdict(pinv_step, seed=None):
+    """Verdict for exercise 3 without printing (`seed`: the grader's hidden cases)."""
+    name, cases = FUNCTIONS[0], _pinv_cases(seed)
+    answer = _answers(pinv_step, name)
 
     def result(case):
-        if id(case) not in cache:
-            J, e, rcond = case.args
-            try:
-                got = _call(fn, name, case, J.copy(), e.copy(), rcond)
-            except _Fail as exc:
-                shapes = ("mismatch in its core dimension", "not aligned", "shapes")
-                if type(exc) is _Fail and any(word in str(exc) for word in shapes):
-                    raise _Fail(str(exc) + SWAP_HINT) from None
-                raise
-            cache[id(case)] = _as_array(got, name, case)
-        return cache[id(case)]
+        try:
+            return answer(case)
+        except _Fail as exc:  # numpy's error for mismatched shapes: U and V swapped?
+            shapes = ("mismatch in its core dimension", "not aligned", "shapes")
+            if type(exc) is _Fail and any(word in str(exc) for word in shapes):
+                raise _Fail(str(exc) + SWAP_HINT) from None
+            raise
 
     def compared(tag, signed):
         """None, or the message of the first case of `tag` that fails (`signed`: the sign
@@ -160,9 +158,7 @@ def _pinv_parts(fn, name, seed=None):
             if tag == "cutoff" and all(  # every case: sigma_i < rcond dropped
                     _close(np.abs(g), np.abs(_pinv_variant(*c.args[:2], lambda s, r=c.args[2]:
                                                             s >= r))) for c, g in results):
-                return ("the cut-off must be relative: drop sigma_i < rcond * sigma_max "
-                        "(the largest singular value), not sigma_i < rcond."
-                        + _mismatch(got, want, case))
+                return RELATIVE + _mismatch(got, want, case)
             fixed = _fixed_cutoff(results) if tag == "cutoff" else None
             if fixed is not None:
                 return (f"your cut-off ignores `rcond`: on every case it drops what "
@@ -176,12 +172,8 @@ def _pinv_parts(fn, name, seed=None):
                         + _mismatch(got, want, case))
             return _diagnose(got, want, case)
 
-    return [_Part("regular", 2, lambda: compared("regular", signed=False)),
-            _Part("sign", 3, lambda: compared("regular", signed=True)),
-            _Part("small sigma dropped", 3, lambda: compared("cutoff", signed=False)),
-            _Part("sigma_max = 0 guard", 2, lambda: compared("zero", signed=False))]
-
-
-def verdict(pinv_step, seed=None):
-    """Verdict for exercise 3 without printing (`seed`: the grader's hidden cases)."""
-    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _pinv_parts(pinv_step, FUNCTIONS[0], seed))
+    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), [
+        _Part("regular", 2, lambda: compared("regular", signed=False)),
+        _Part("sign", 3, lambda: compared("regular", signed=True)),
+        _Part("small sigma dropped", 3, lambda: compared("cutoff", signed=False)),
+        _Part("sigma_max = 0 guard", 2, lambda: compared("zero", signed=False))])

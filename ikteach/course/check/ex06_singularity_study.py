@@ -13,7 +13,7 @@ from ...core.dls import dls_step as _ref_dls
 from ...core.jt import jt_step as _ref_jt
 from ...core.pinv import pinv_step as _ref_pinv
 from ...core.solve import solve as _solve
-from .verdicts import (_call, _evaluate, _Fail, _Part, SOLVE_LIMIT)
+from .verdicts import SOLVE_LIMIT, _call, _evaluate, _Fail, _Part
 
 NUMBER = 6
 CHECK_NAME = "singularity_study"
@@ -82,9 +82,11 @@ def _same_answer(got, want):
         return False
 
 
-def _study_parts(study):
-    name = "study"
-    state = {}
+def verdict(study, seed=None):
+    """Verdict for exercise 6 without printing. `seed` is not used: the study's answers are
+    values read off the notebook's own runs (fixed arm and targets), so there are no hidden
+    cases - the instructor reads the code and the written answer."""
+    name, state = FUNCTIONS[0], {}
 
     def answers():
         if "answers" not in state:
@@ -109,11 +111,4 @@ def _study_parts(study):
                         f"{meaning} - run the solves and read it off the results.")
         return _Part(key, points, check)
 
-    return [question(key) for key in _QUESTIONS]
-
-
-def verdict(study, seed=None):
-    """Verdict for exercise 6 without printing. `seed` is not used: the study's answers are
-    values read off the notebook's own runs (fixed arm and targets), so there are no hidden
-    cases - the instructor reads the code and the written answer."""
-    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _study_parts(study))
+    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), [question(key) for key in _QUESTIONS])

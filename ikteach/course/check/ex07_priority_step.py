@@ -7,7 +7,7 @@ no damping (lambda = 0, J1 singular or not: the exact pseudoinverses, finite) 2.
 import numpy as np
 
 from ...core.priority import priority_step as _ref_step
-from .verdicts import (_as_array, _call, _Case, _close, _evaluate, _Fail, _fmt, _in_every_draw,
+from .verdicts import (_answers, _Case, _close, _evaluate, _Fail, _fmt, _in_every_draw,
                        _mismatch, _Part, _rng, _shape_message, _turned)
 
 NUMBER = 7
@@ -156,7 +156,7 @@ def _priority_cases(seed=None):
         lam = round(float(rng.uniform(0.05, 0.8)), 3)
         cases.append(_Case((J1, e1, J2, e2, lam), _priority_text(J1, e1, J2, e2, lam),
                            size=n * (m1 + m2) * 100 + 50 + k, tag="regular"))
-    return sorted(cases, key=lambda c: c.size)
+    return cases
 
 
 def _priority_text(J1, e1, J2, e2, lam, note=""):
@@ -164,16 +164,10 @@ def _priority_text(J1, e1, J2, e2, lam, note=""):
             f"damping = {lam:g}" + (f" ({note})" if note else ""))
 
 
-def _priority_parts(fn, name, seed=None):
-    cases = _priority_cases(seed)
-    cache = {}
-
-    def result(case):
-        if id(case) not in cache:
-            J1, e1, J2, e2, lam = case.args
-            got = _call(fn, name, case, J1.copy(), e1.copy(), J2.copy(), e2.copy(), lam)
-            cache[id(case)] = _as_array(got, name, case)
-        return cache[id(case)]
+def verdict(priority_step, seed=None):
+    """Verdict for exercise 7 without printing (`seed`: the grader's hidden cases)."""
+    name, cases = FUNCTIONS[0], _priority_cases(seed)
+    result = _answers(priority_step, name)
 
     def diagnose(got, want, case):
         if got.shape != want.shape:
@@ -224,11 +218,6 @@ def _priority_parts(fn, name, seed=None):
             if not _primary_kept(got, J1, e1, lam):
                 return diagnose(got, case.want(_ref_priority), case)
 
-    return [_Part("primary kept", 3, primary_kept), _Part("secondary", 3, against_reference("regular")),
-            _Part("singular", 2, against_reference("singular")), _Part("no damping", 2, no_damping)]
-
-
-def verdict(priority_step, seed=None):
-    """Verdict for exercise 7 without printing (`seed`: the grader's hidden cases)."""
-    return _evaluate(NUMBER, TITLE, list(FUNCTIONS),
-                     _priority_parts(priority_step, "priority_step", seed))
+    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), [
+        _Part("primary kept", 3, primary_kept), _Part("secondary", 3, against_reference("regular")),
+        _Part("singular", 2, against_reference("singular")), _Part("no damping", 2, no_damping)])

@@ -5,6 +5,7 @@ Every exercise module (ex01_jacobian.py, ...) builds a list of _Part(name, point
 run() returns None (the part passed) or the message of its smallest failing case, and hands it
 to _evaluate(number, title, function_names, parts).
 """
+import collections
 import contextlib
 import contextvars
 import dataclasses
@@ -137,6 +138,19 @@ def _as_array(value, name, case):
     return arr
 
 
+def _answers(fn, name):
+    """answer(case): fn on copies of the case's arguments, as a float64 array (_as_array),
+    computed once per case (several parts ask for it)."""
+    cache = {}
+
+    def answer(case):
+        if id(case) not in cache:
+            args = [a.copy() if hasattr(a, "copy") else a for a in case.args]
+            cache[id(case)] = _as_array(_call(fn, name, case, *args), name, case)
+        return cache[id(case)]
+    return answer
+
+
 # --- cases and comparisons -------------------------------------------------------------------
 
 def _fmt(x, digits=4):
@@ -218,6 +232,11 @@ def _turned(rng, Js, es):
             [scale * (P @ e) + 0.0 for P, e in zip(Ps, es)])
 
 
+def _turned_hand(rng, hand):
+    """Hand cases (J, e, anything else...) turned one by one (_turned), the rest kept."""
+    return [(*(x[0] for x in _turned(rng, [J], [e])), *rest) for J, e, *rest in hand]
+
+
 def _rng(seed, offset):
     """The cases' random generator: seed None gives the instant check's (SEED + offset: what a
     student sees in the notebook), an int the grader's added cases (drawn at grading time)."""
@@ -258,17 +277,11 @@ class Verdict:
     def passed(self):
         return self.status == "passed"
 
-    def summary(self):
-        """One line, for the grader's feedback file."""
-        return self.message.splitlines()[0]
-
     def __str__(self):
         return self.message
 
 
-class _Part:
-    def __init__(self, name, points, run):
-        self.name, self.points, self.run = name, points, run
+_Part = collections.namedtuple("_Part", "name points run")  # run() -> None or the message
 
 
 def _evaluate(number, name, function_names, parts):
