@@ -1,8 +1,6 @@
 """Grade the students' exercise notebooks.
 
-    python -m ikteach.course.grade SUBMISSIONS_DIR --out grades.csv [--feedback DIR] [--timeout S]
-                            [--grade-timeout S] [--jobs N] [--memory-mb M] [--tmpfs-mb T]
-                            [--seed N] [--no-sandbox]
+    python -m ikteach.course.grade SUBMISSIONS_DIR --out grades.csv [--jobs N] [...: --help]
     python -m ikteach.course.grade --gradescope OUT.zip      (a Gradescope autograder bundle)
 
 SUBMISSIONS_DIR holds one folder per student (the folder name is the student) with that
@@ -41,8 +39,8 @@ from pathlib import Path
 
 from .exercises import ANSWER_PLACEHOLDER
 from .grading.recognise import exercise_number, identify  # noqa: F401 (grade.identify)
-from .grading.report import EXERCISE_NUMBERS, POINTS, RERUN, labels, write_results
-from .grading.submissions import MAX_NOTEBOOK_BYTES, notebooks, read_notebook, students, text
+from .grading.report import POINTS, RERUN, labels, write_results
+from .grading.submissions import notebooks, read_notebook, students, text
 
 NOTEBOOK_TIMEOUT = 120.0  # seconds for all of a student's cells
 GRADE_TIMEOUT = 180.0     # seconds for a notebook's checks: every call
@@ -50,8 +48,7 @@ GRACE = 15.0              # the fork server's kill comes first; then the grader 
 MAX_NOTEBOOKS = 3 * 7      # notebooks graded per student (the rest: a note)
 INSTRUCTOR = Path(__file__).resolve().parents[2] / "instructor"  # the solutions: hidden
 
-__all__ = ["grade_all", "grade_notebook", "grade_book", "exercise_number", "main",
-           "MAX_NOTEBOOK_BYTES"]
+__all__ = ["grade_all", "grade_notebook", "grade_book", "exercise_number", "main"]
 
 
 def _answer_text(book):

@@ -14,8 +14,7 @@ NUMBER = 1
 CHECK_NAME = "jacobian"
 TITLE = "the geometric Jacobian"
 FUNCTIONS = ("planar_jacobian",)
-# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
-REFERENCES = ("ikteach.core.jacobian:jacobian",
+REFERENCES = ("ikteach.core.jacobian:jacobian",  # ikteach's answers, stubbed when graded
               "ikteach.core.jacobian:jacobian_from_frames",
               "ikteach.core.jacobian:jacobian_autodiff",
               "ikteach.core.jacobian:jacobian_fd",

@@ -13,8 +13,8 @@ NUMBER = 2
 CHECK_NAME = "jt_step"
 TITLE = "the Jacobian-transpose step"
 FUNCTIONS = ('jt_step',)
-# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
-REFERENCES = ("ikteach.core.jt:jt_step", "ikteach.core.jt:optimal_alpha")
+REFERENCES = ("ikteach.core.jt:jt_step",  # ikteach's answers, stubbed when graded
+              "ikteach.core.jt:optimal_alpha")
 
 HAND = [(np.eye(2), np.array([1.0, 0.0]), "regular"),
         (np.array([[1.0, 0.0, 0.0], [0.0, 2.0, 0.0]]), np.array([1.0, 1.0]), "regular"),

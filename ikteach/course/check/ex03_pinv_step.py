@@ -15,8 +15,8 @@ NUMBER = 3
 CHECK_NAME = "pinv_step"
 TITLE = "the pseudoinverse step"
 FUNCTIONS = ('pinv_step',)
-# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
-REFERENCES = ("ikteach.core.pinv:pinv_step", "ikteach.core.pinv:pinv_two_rows",
+REFERENCES = ("ikteach.core.pinv:pinv_step",  # ikteach's answers, stubbed when graded
+              "ikteach.core.pinv:pinv_two_rows",
               "ikteach.core.priority:damped_pinv")  # damping 0: J^+
 FIXED_CUTOFFS = tuple(10.0 ** (-k / 4) for k in range(33))  # a step ignoring rcond
 SWAP_HINT = ("\n  hint: J (m x n) = U Sigma V^T with U m x k and V n x k: U^T takes e (m entries) "

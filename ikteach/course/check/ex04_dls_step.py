@@ -14,8 +14,7 @@ NUMBER = 4
 CHECK_NAME = "dls_step"
 TITLE = "damped least squares"
 FUNCTIONS = ('dls_step', 'dls_step_normal')
-# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
-REFERENCES = ("ikteach.core.dls:dls_step",
+REFERENCES = ("ikteach.core.dls:dls_step",  # ikteach's answers, stubbed when graded
               "ikteach.core.dls:dls_step_normal",
               "ikteach.core.dls:dls_step_small",  # what ik.DLS runs on 2-3 rows
               "ikteach.core.dls:damped_step",  # ik.DLS's choice between the two

@@ -20,8 +20,7 @@ NUMBER = 5
 CHECK_NAME = "stop_rule"
 TITLE = "the out-of-reach stop rule"
 FUNCTIONS = ('stalled', 'stop_rule_step')
-# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
-REFERENCES = ("ikteach.core.stop_rules:joint_steps",
+REFERENCES = ("ikteach.core.stop_rules:joint_steps",  # ikteach's answers, stubbed when graded
               "ikteach.core.stop_rules:motion",
               "ikteach.core.stop_rules:step_size",
 )

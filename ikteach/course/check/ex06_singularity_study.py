@@ -19,8 +19,7 @@ NUMBER = 6
 CHECK_NAME = "singularity_study"
 TITLE = "a singularity study"
 FUNCTIONS = ('study',)
-# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
-REFERENCES = ()
+REFERENCES = ()  # ikteach's answers, stubbed when graded
 
 STUDY_ARM = [1.0, 1.0, 1.0]
 STUDY_THETA0 = [0.3, 0.2, 0.1]

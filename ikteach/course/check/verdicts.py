@@ -286,25 +286,22 @@ _Part = collections.namedtuple("_Part", "name points run")  # run() -> None or t
 
 def _evaluate(number, name, function_names, parts):
     """Run every part; the first failure (smallest case) becomes the message."""
-    results, first_failure, not_yet = {}, None, set()
+    results, first_failure, not_yet = dict.fromkeys((p.name for p in parts), False), None, set()
     for part in parts:
         try:
             problem = part.run()
         except _NotYet as exc:
             not_yet.add(str(exc))
             problem = f"`{exc}` is not yet implemented (it raises NotImplementedError)."
-        except _Abort as exc:
-            results[part.name] = False
+        except _Abort as exc:  # the parts left stay failed
             first_failure = first_failure or str(exc)
-            for rest in parts[parts.index(part) + 1:]:
-                results[rest.name] = False
             break
         except _Fail as exc:
             problem = str(exc)
         results[part.name] = problem is None
         if problem is not None and first_failure is None:
             first_failure = problem
-    score = float(sum(p.points for p in parts if results.get(p.name)))
+    score = float(sum(p.points for p in parts if results[p.name]))
     total = float(sum(p.points for p in parts))
     title = f"Exercise {number} ({name})"
     if not_yet and score == 0 and not_yet >= set(function_names):
@@ -315,6 +312,6 @@ def _evaluate(number, name, function_names, parts):
     if first_failure is None:
         return Verdict(number, name, "passed", score, total,
                        f"{title}: passed, {score:g}/{total:g} - well done!", results)
-    marks = "  ".join(f"{p.name} {'ok' if results.get(p.name) else 'x'}" for p in parts)
+    marks = "  ".join(f"{p.name} {'ok' if results[p.name] else 'x'}" for p in parts)
     return Verdict(number, name, "failed", score, total,
                    f"{title}: {score:g}/{total:g} - {first_failure}\n  parts: {marks}", results)

@@ -42,13 +42,6 @@ LEFT_OUT = ("course/check", "course/grade.py", "course/grading/selfcheck.py",
             "course/grading/gradescope.py", "course/grading/autograder.py")
 
 
-def _stub_body(qualname, exercise):
-    label = (f"ikteach's {qualname} is the reference answer of exercise {exercise}; graded "
-             "code must compute it itself")
-    return ast.parse("from ikteach.course.grading.own_code import ReferenceBlocked\n"
-                     f"raise ReferenceBlocked({label!r})\n").body
-
-
 def stub_source(source, names, exercise):
     """`source` (a module's text) with the top-level functions `names` raising instead; their
     signatures and decorators stay, so every caller (jit, a method table) still works."""
@@ -56,7 +49,10 @@ def stub_source(source, names, exercise):
     found = set()
     for node in tree.body:
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and node.name in names:
-            node.body = _stub_body(node.name, exercise)
+            label = (f"ikteach's {node.name} is the reference answer of exercise {exercise}; "
+                     "graded code must compute it itself")
+            node.body = ast.parse("from ikteach.course.grading.own_code import ReferenceBlocked"
+                                  f"\nraise ReferenceBlocked({label!r})\n").body
             found.add(node.name)
     if found != set(names):
         raise ValueError(f"references: {sorted(set(names) - found)} are not top-level "

@@ -2,11 +2,10 @@
 why a notebook was not graded, copied: graded code that is ikteach's own answer, for the
 instructor to judge) and one feedback file per student. Every text is printable UTF-8, no
 control or bidi character in it (grading/submissions.text; the feedback keeps its newlines),
-whatever the file names and notebooks held; no CSV cell starts a
-spreadsheet formula; each student's name is NFC-normalised, or written with escapes where two
-names differ only in normalisation, and with a hash of the folder's bytes where two still look
-alike (labels()): every folder its own row and feedback file; a feedback file name is short
-whatever the name's length."""
+whatever the file names and notebooks held; no CSV cell starts a spreadsheet formula; each
+student's name is NFC-normalised, or written with escapes where two names differ only in
+normalisation, and with a hash of the folder's bytes where two still look alike (labels()):
+every folder its own row and feedback file, whose name is short whatever the student's."""
 import csv
 import hashlib
 import os
