@@ -150,12 +150,9 @@ def grade_book(name, book, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT
     return result
 
 
-def grade_notebook(path, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT, sandbox=None,
-                   problem=None, seed=None):
-    """Grade one notebook file (read as untrusted: see grading/submissions.py)."""
-    from .grading.sandbox import Sandbox
-
-    sandbox = sandbox or Sandbox()  # raises SandboxUnavailable where there is none
+def grade_notebook(path, timeout, grade_timeout, sandbox, problem=None, seed=None):
+    """Grade one notebook file (read as untrusted: see grading/submissions.py) in `sandbox`
+    (`problem`: why it is not read, found when it was listed)."""
     path = Path(path)
     number = exercise_number(path, None)
     if problem is None:

@@ -56,24 +56,24 @@ def _jacobian_reference(lengths, theta):
 
 
 def _diagnose_jacobian(got, want, case):
+    detail = _mismatch(got, want, case, "J")
     if not np.all(np.isfinite(got)):
-        return f"your Jacobian contains NaN or inf.{_mismatch(got, want, case, 'J')}"
+        return "your Jacobian contains NaN or inf." + detail
     if _close(got, -want):
         return ("wrong sign: your Jacobian is -1 x the expected one. Column i is "
-                "z_i x (p_e - p_i) = z x (p_e - p_i) = (-(y_e - y_i), x_e - x_i)."
-                + _mismatch(got, want, case, "J"))
+                "z_i x (p_e - p_i) = z x (p_e - p_i) = (-(y_e - y_i), x_e - x_i)." + detail)
     for row, other, what in ((0, 1, "row 0 (x) is -(y_e - y_i)"), (1, 0, "row 1 (y) is x_e - x_i")):
         if _close(got[row], -want[row], scale=np.abs(want).max()) and _close(
                 got[other], want[other], scale=np.abs(want).max()):
             return (f"row {row} has the wrong sign (the other row is right): z x (p_e - p_i) = "
-                    f"(-(y_e - y_i), x_e - x_i), so {what}." + _mismatch(got, want, case, "J"))
+                    f"(-(y_e - y_i), x_e - x_i), so {what}." + detail)
     if _close(got, want[:, ::-1]):
         return ("the columns are in reverse order: column i belongs to joint i (J[:, 0] is "
-                "joint 1, at the base)." + _mismatch(got, want, case, "J"))
+                "joint 1, at the base)." + detail)
     if _close(got, want[::-1]):
-        return "rows swapped: row 0 is dx, row 1 is dy." + _mismatch(got, want, case, "J")
+        return "rows swapped: row 0 is dx, row 1 is dy." + detail
     return ("wrong values: column i should be z x (p_e - p_i), p_i the position of joint i "
-            "(p_1 = the base = row 0 of ik.joint_positions), p_e the end effector." + _mismatch(got, want, case, "J"))
+            "(p_1 = the base = row 0 of ik.joint_positions), p_e the end effector." + detail)
 
 
 def _columns_up_to_sign(got, want):

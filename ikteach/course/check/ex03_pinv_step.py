@@ -84,18 +84,16 @@ def _relative(rcond):
 
 
 def _fixed_cutoff(results):
-    """(low, high): the fixed relative cut-offs (a grid from 1 to 1e-8, 4 per decade) that
-    give the student's step on every case of `results` ([(case, got)]), or None. The cases
+    """The fixed relative cut-offs (a grid from 1 to 1e-8, 4 per decade) that give the
+    student's step on every case of `results` ([(case, got)]), in words, or None. The cases
     cannot tell apart cut-offs between two of their singular value ratios: the message names
     the whole range, not one value of it."""
     fits = [c for c in FIXED_CUTOFFS
             if all(_close(np.abs(got), np.abs(_pinv_variant(*case.args[:2], _relative(c))))
                    for case, got in results)]
-    return (min(fits), max(fits)) if fits else None
-
-
-def _cutoff_text(fits):
-    low, high = fits
+    if not fits:
+        return None
+    low, high = min(fits), max(fits)
     if low == high:
         return f"a fixed relative cut-off of {low:.2g}"
     return f"a fixed relative cut-off (any between {low:.2g} and {high:.2g} fits these cases)"
@@ -104,26 +102,26 @@ def _cutoff_text(fits):
 def _diagnose(got, want, case):
     """What is wrong with a step that is not J^+ e (nor -J^+ e)."""
     J, e, rcond = case.args
+    detail = _mismatch(got, want, case)
     if not np.all(np.isfinite(got)):
         return ("NaN or inf at a singular J: 1/sigma for a tiny or zero sigma. "
-                "Drop 1/sigma_i (use 0) for sigma_i < rcond * sigma_max." + _mismatch(got, want, case))
+                "Drop 1/sigma_i (use 0) for sigma_i < rcond * sigma_max." + detail)
     swapped = _pinv_variant(J, e, _relative(rcond), swapped=True)
     if swapped is not None and (_close(got, swapped) or _close(got, -swapped)):
         return ("U and V swapped: delta_theta = V Sigma^+ U^T e (np.linalg.svd returns U, "
-                "sigma and V^T)." + _mismatch(got, want, case))
+                "sigma and V^T)." + detail)
     if not np.any(got) and np.linalg.norm(J, 2) < 1e-2:
         return ("your step is zero for a small J: the cut-off is relative, so J's largest "
-                "singular values are kept however small (a guard at a fixed sigma_max?)."
-                + _mismatch(got, want, case))
+                "singular values are kept however small (a guard at a fixed sigma_max?)." + detail)
     uncut = _pinv_variant(J, e, lambda s: s > 0)
     if _close(got, uncut, rtol=1e-4) and not _close(uncut, want, rtol=1e-4):
         return ("no cut-off: 1/sigma_i must be dropped for sigma_i < rcond * "
                 f"sigma_max; here your step is {np.linalg.norm(got):.3g} long (np.linalg.pinv(J) "
-                "keeps every sigma_i >= 1e-15 sigma_max)." + _mismatch(got, want, case))
+                "keeps every sigma_i >= 1e-15 sigma_max)." + detail)
     if _close(got, _pinv_variant(J, e, lambda s: s >= rcond)):
-        return RELATIVE + _mismatch(got, want, case)
+        return RELATIVE + detail
     return ("wrong values: delta_theta = sum_i (u_i . e / sigma_i) v_i over the "
-            "sigma_i kept by the cut-off." + _mismatch(got, want, case))
+            "sigma_i kept by the cut-off." + detail)
 
 
 def verdict(pinv_step, seed=None):
@@ -162,7 +160,7 @@ def verdict(pinv_step, seed=None):
             fixed = _fixed_cutoff(results) if tag == "cutoff" else None
             if fixed is not None:
                 return (f"your cut-off ignores `rcond`: on every case it drops what "
-                        f"{_cutoff_text(fixed)} drops; here rcond = {rcond:g}. Drop "
+                        f"{fixed} drops; here rcond = {rcond:g}. Drop "
                         "sigma_i < rcond * sigma_max with the rcond passed in."
                         + _mismatch(got, want, case))
             if tag == "zero":

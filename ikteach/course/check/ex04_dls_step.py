@@ -87,19 +87,16 @@ def verdict(dls_step, dls_step_normal, seed=None):
             not _close(p, np.asarray(_ref_dls(*c.args))) for (c, _), p in zip(found, plain))
 
     def diagnose(which, got, want, case):
-        name = names[which]
+        name, detail = names[which], _mismatch(got, want, case)
         if not np.all(np.isfinite(got)):
             return ("NaN or inf near a singularity: with damping > 0, J J^T + "
-                    "lambda^2 I is always invertible - no pseudoinverse needed."
-                    + _mismatch(got, want, case))
+                    "lambda^2 I is always invertible - no pseudoinverse needed." + detail)
         if _close(got, np.asarray(_ref_dls(*case.args[:2], np.sqrt(case.args[2])))):
             return (f"missing square on lambda: `{name}` adds lambda I, the damping "
-                    "term is lambda^2 I (from lambda^2 |delta_theta|^2)."
-                    + _mismatch(got, want, case))
+                    "term is lambda^2 I (from lambda^2 |delta_theta|^2)." + detail)
         if _close(got, -want):
-            return "wrong sign." + _mismatch(got, want, case)
-        return f"wrong values: `{name}` should compute {FORMS[which]}." + _mismatch(
-            got, want, case)
+            return "wrong sign." + detail
+        return f"wrong values: `{name}` should compute {FORMS[which]}." + detail
 
     def form(which):
         name = names[which]

@@ -160,23 +160,23 @@ def verdict(priority_step, seed=None):
     def diagnose(got, want, case):
         if got.shape != want.shape:
             return _shape_message(name, got, want, case, " - one entry per joint")
-        J1, e1, _, _, lam = case.args
+        (J1, e1, _, _, lam), detail = case.args, _mismatch(got, want, case)
         if not np.all(np.isfinite(got)):
             if lam == 0:
                 return ("your step is NaN or inf at damping = 0 where J1 is singular. "
-                        + _AT_ZERO + _mismatch(got, want, case))
+                        + _AT_ZERO + detail)
             return ("NaN or inf where J1 (or J2 N1) is singular: use damped pseudoinverses, "
                     "A^T (A A^T + lambda^2 I)^-1, which stay finite for damping > 0 (A A^T + "
-                    "lambda^2 I is then invertible)." + _mismatch(got, want, case))
+                    "lambda^2 I is then invertible)." + detail)
         for variant, why in _priority_variants(*case.args):
             if _close(got, variant) and not (lam == 0 and "damping" in why):
-                return why + _mismatch(got, want, case)
+                return why + detail
         if not _primary_kept(got, J1, e1, lam):
             return ("the primary task is disturbed: J1 delta_theta should equal J1 J1+ e1 "
                     "(the secondary may move only in J1's null space)."
                     + _mismatch(J1 @ got, J1 @ want, case, "J1 delta_theta"))
         return (f"wrong values: `{name}` should compute J1+ e1 + N1 (J2 N1)+ (e2 - J2 J1+ e1)."
-                + _mismatch(got, want, case))
+                + detail)
 
     def against_reference(tag):
         def check():
