@@ -110,10 +110,9 @@ def _stop_cases(seed=None):
         size = fraction * lengths.sum() * float(rng.choice([0.4, 2.5]))
         w = rng.dirichlet(np.ones(n)) * size * rng.choice([-1.0, 1.0], n)
         hand.append((w.tolist(), lengths.tolist(), fraction))
-    cases = [_Case((np.array(d), list(L), f),
-                   f"delta_theta = {_fmt(d)}, lengths = {_fmt(L)}, fraction = {f:g}",
-                   size=len(d) * 100 + k) for k, (d, L, f) in enumerate(hand)]
-    return cases
+    return [_Case((np.array(d), list(L), f),
+                  f"delta_theta = {_fmt(d)}, lengths = {_fmt(L)}, fraction = {f:g}",
+                  size=len(d) * 100 + k) for k, (d, L, f) in enumerate(hand)]
 
 
 def _as_bool(value, name, case):
@@ -132,7 +131,6 @@ _EXPECTED_STOP = {}  # the reference's stalled solve (the same in every draw), r
 def verdict(stalled, stop_rule_step, seed=None):
     """Verdict for exercise 5 without printing (`seed`: the grader's hidden cases)."""
     names = FUNCTIONS
-    arm_lengths, target, theta0 = STOP_ARM, STOP_TARGET, STOP_THETA0  # in every draw
 
     def rule():
         cases = _stop_cases(seed)
@@ -155,17 +153,17 @@ def verdict(stalled, stop_rule_step, seed=None):
 
     def reference_step(J, e):
         delta = np.asarray(_BASE_STEP(J, e))
-        if _stalled_reference(delta, arm_lengths, STOP_FRACTION):
+        if _stalled_reference(delta, STOP_ARM, STOP_FRACTION):
             raise StopSolve("out of reach")
         return delta
 
     def run_solve(step, name):
-        case = (f"ik.solve(ik.planar_chain({arm_lengths}), target={target}, "
-                f"theta0={theta0}, method=your step, stall_tol=0)")
-        arm = planar_chain(arm_lengths)
+        case = (f"ik.solve(ik.planar_chain({STOP_ARM}), target={STOP_TARGET}, "
+                f"theta0={STOP_THETA0}, method=your step, stall_tol=0)")
+        arm = planar_chain(STOP_ARM)  # one arm and target, in every draw
 
         def go():
-            return _solve(arm, np.array(target), np.array(theta0), method=step,
+            return _solve(arm, np.array(STOP_TARGET), np.array(STOP_THETA0), method=step,
                           stall_tol=0.0, max_iter=STOP_MAX_ITER)
         try:
             return _call(go, name, case, limit=SOLVE_LIMIT), case
@@ -207,10 +205,9 @@ def verdict(stalled, stop_rule_step, seed=None):
         problem = wrapper_on_the_rules_cases()
         if problem is not None:
             return problem
-        case = (f"stop_rule_step(step, lengths={arm_lengths}, fraction={STOP_FRACTION:g}) "
+        case = (f"stop_rule_step(step, lengths={STOP_ARM}, fraction={STOP_FRACTION:g}) "
                 f"with step = DLS (damping {STOP_DAMPING:g})")
-        step = _call(stop_rule_step, names[1], case, _BASE_STEP, list(arm_lengths),
-                     STOP_FRACTION)
+        step = _call(stop_rule_step, names[1], case, _BASE_STEP, list(STOP_ARM), STOP_FRACTION)
         if not callable(step):
             return (f"`{names[1]}` must return a step function step(J, e) -> delta_theta; "
                     f"it returned {type(step).__name__}.")
