@@ -67,10 +67,8 @@ def _answer_text(book):
 
 def _run(number, book, sandbox, timeout, grade_timeout, seed=None):
     """(verdict or None, notes, copied, stopped): the notebook's cells and then ik.check's
-    calls in one job (grading/cells.py), the verdict computed in this process on the hidden
-    cases drawn from `seed`, each call's limit counting the job's CPU seconds; notes: the
-    cells' errors and what went wrong on the way; stopped: a time limit of the checks ended a
-    call."""
+    calls in one job, the verdict computed here on the hidden cases drawn from `seed`; notes:
+    the cells' errors and what went wrong; stopped: a time limit of the checks ended a call."""
     from . import check
     from .check.verdicts import CPU_CLOCK
     from .grading import reference
@@ -110,11 +108,9 @@ def _result(name, number=None, message=""):
 def grade_book(name, book, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT,
                sandbox=None, seed=None):
     """Grade one notebook (a dict) on the hidden cases drawn from `seed` (None: a fresh secret
-    one - never the instant check's public cases); returns a dict: file, exercise, how (how the
-    exercise was recognised), score, max, status, message, notes (what went wrong on the way),
-    answer (the written answer, if any), copied (functions whose code is ikteach's answer: for
-    the instructor), seed. A notebook whose call the checks' time limit stopped is run once
-    more, in a fresh sandbox, before the timeout costs marks."""
+    one); returns a dict: file, exercise, how (how the exercise was recognised), score, max,
+    status, message, notes (what went wrong on the way), answer (the written answer, if any),
+    copied (functions whose code is ikteach's answer: for the instructor), seed, seconds."""
     from .grading import servers
     from .grading.sandbox import Sandbox
 

@@ -35,11 +35,10 @@ HAND = [(np.array([[0.0, 0.0], [3.0, 2.0]]), np.array([1.0, 0.5]), 0.5, "singula
 @_in_every_draw
 def _dls_cases(seed=None):
     rng = _rng(seed, 4)
-    cases = []
     hand = HAND if seed is None else _turned_hand(rng, HAND)  # the same damping
-    for k, (J, e, lam, note) in enumerate(hand):
-        cases.append(_Case((J, e, lam), _matrix_text(J, e, f", damping = {lam:g}")
-                           + (f" ({note})" if note else ""), size=J.size * 100 + k))
+    cases = [_Case((J, e, lam), _matrix_text(J, e, f", damping = {lam:g}")
+                   + (f" ({note})" if note else ""), size=J.size * 100 + k)
+             for k, (J, e, lam, note) in enumerate(hand)]
     for k in range(12):
         m = int(rng.integers(2, 4))
         n = int(rng.integers(1, 7))

@@ -1,10 +1,6 @@
 """The shared verdict machinery of ik.check: run student code safely, build cases, compare,
-score by parts, and word the one verdict a student sees.
-
-Every exercise module (ex01_jacobian.py, ...) builds a list of _Part(name, points, run) whose
-run() returns None (the part passed) or the message of its smallest failing case, and hands it
-to _evaluate(number, title, function_names, parts).
-"""
+score by parts (_Part, _evaluate: how an exercise module uses them is in check/__init__.py),
+and word the one verdict a student sees."""
 import collections
 import contextlib
 import contextvars
@@ -92,7 +88,8 @@ def _student_line(exc):
 
 
 def _call(fn, name, case, *args, limit=None):
-    """fn(*args) under a time limit; student errors become _NotYet/_Fail/_Abort."""
+    """fn(*args) under a time limit (None: TIME_LIMIT, read at the call); student errors
+    become _NotYet/_Fail/_Abort."""
     limit = TIME_LIMIT if limit is None else limit
     if not callable(fn):
         raise _Fail(f"expected your function `{name}`, got {type(fn).__name__} {fn!r:.40}")
