@@ -87,8 +87,7 @@ def _run(number, book, sandbox, timeout, grade_timeout, seed=None):
             return (None, worker.errors + (worker.notes or [f"nothing could be graded: {exc}"]),
                     [], False)
         notes = worker.errors + worker.notes
-        # reported, never scored: the fingerprints of the code the cells' source defines,
-        # computed in a job where no student code ran (held), against the references'
+        # reported, never scored: the cells' source, fingerprinted where no student code ran
         copied = reference.copied(held, reference.reference_fingerprints(module.REFERENCES))
         if worker.foreign:  # a graded name bound to ikteach's (or anyone's) code: no marks
             return (check.registry.refuse(number, " ".join(worker.foreign.values())), notes,
@@ -116,8 +115,7 @@ def grade_book(name, book, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT
 
     sandbox = sandbox or Sandbox()  # raises SandboxUnavailable where there is none
     number, how = identify(name, book)
-    result = _result(name, number)
-    result["how"] = how
+    result = dict(_result(name, number), how=how)
     result["seed"] = seed = secrets.randbits(63) if seed is None else int(seed)
     if number is None:
         result["message"] = ("not an exercise notebook (no ikteach exercise in its metadata, "
@@ -252,9 +250,8 @@ def grade_all(submissions, out, feedback=None, timeout=NOTEBOOK_TIMEOUT, jobs=1,
             log(f"ignored (not a student folder): {text(name)}")
         jobs_list, per_student, notes = [], {}, {}
         for name, folder, problem in found:
-            per_student[name], notes[name] = [], []
+            per_student[name], notes[name] = [], [problem] if problem else []
             if problem:
-                notes[name].append(problem)
                 continue
             try:
                 books = notebooks(folder)

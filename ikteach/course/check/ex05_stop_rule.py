@@ -116,8 +116,7 @@ def _stop_cases(seed=None):
 
 
 def _as_bool(value, name, case):
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
+    """A True/False answer (a bool, or a number or 0-d array of one), or a _Fail."""
     arr = np.asarray(value) if value is not None else None
     if arr is not None and arr.shape == () and arr.dtype.kind in "biuf":
         return bool(arr)

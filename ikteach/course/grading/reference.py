@@ -20,8 +20,8 @@ or pasted in). That is copying, which only a reader can judge; fingerprint() mak
 copy visible: a code object's operations, names, docstrings, file names and line numbers
 ignored, compared with the references' (copied(): what matched and how many operations), for
 the cells' source compiled in a job where no student code has run (source_fingerprints).
-Reordered, rewritten or split code, and code loaded at run time, is not seen. The
-work is bounded whatever a file holds (MAX_CODES, MAX_CODE_BYTES, MAX_TOTAL_BYTES).
+Reordered, rewritten or split code, and code loaded at run time, is not seen. The work is
+bounded whatever a file holds (MAX_CODES, MAX_CODE_BYTES, MAX_TOTAL_BYTES).
 """
 import ast
 import compileall

@@ -58,7 +58,6 @@ def file_name(label):
     return raw[:MAX_FILE_NAME].decode("utf-8", "ignore") + "-" + digest + ".txt"
 
 
-
 def _feedback_text(student, results):
     lines = [f"Feedback for {student}", ""]
     by_number = _best(results)  # the CSV's choice
@@ -73,10 +72,8 @@ def _feedback_text(student, results):
         lines += [f"  not counted (the best notebook counts): {o['file']}: {o['score']:g}/"
                   f"{o['max']:g} - {o['message'].splitlines()[0][:200] if o['message'] else ''}"
                   for o in results if o["exercise"] == number and o is not r]
-        for line in r["message"].splitlines():
-            lines.append(f"  {line}")
-        for note in r["notes"]:
-            lines.append(f"  note: {note}")
+        lines += [f"  {line}" for line in r["message"].splitlines()]
+        lines += [f"  note: {note}" for note in r["notes"]]
         copied = r.get("copied", [])
         lines += [f"  for the instructor: {line}" for line in copied]
         if copied:
