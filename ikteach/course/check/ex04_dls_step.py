@@ -57,10 +57,8 @@ def _form_cases(seed=None):
     form. Each is then J^+ e."""
     rng = _rng(seed, 40)
     wide, tall = _random_matrix(rng, 2, 4).round(3), _random_matrix(rng, 4, 2).round(3)
-    return [_Case((wide, rng.normal(size=2).round(3), 0.0),
-                  f"J = {_fmt(wide)} (wide, full row rank)"),
-            _Case((tall, rng.normal(size=4).round(3), 0.0),
-                  f"J = {_fmt(tall)} (tall, full column rank)")]
+    return [_Case((J, rng.normal(size=len(J)).round(3), 0.0), f"J = {_fmt(J)} ({what})")
+            for J, what in ((wide, "wide, full row rank"), (tall, "tall, full column rank"))]
 
 
 NO_DAMPING = ("the damping is missing: your step is the undamped J^+ e (the least-squares step, "

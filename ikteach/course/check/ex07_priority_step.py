@@ -201,10 +201,9 @@ def verdict(priority_step, seed=None):
     def primary_kept():
         """J1 delta = J1 J1+ e1: the secondary adds nothing the primary sees (first order)."""
         for case in (c for c in cases if c.tag != "no damping"):
-            J1, e1, J2, e2, lam = case.args
-            got = result(case)
-            if not _primary_kept(got, J1, e1, lam):
-                return diagnose(got, case.want(_ref_step), case)
+            J1, e1, _, _, lam = case.args
+            if not _primary_kept(result(case), J1, e1, lam):
+                return diagnose(result(case), case.want(_ref_step), case)
 
     return _evaluate(NUMBER, TITLE, list(FUNCTIONS), [
         _Part("primary kept", 3, primary_kept), _Part("secondary", 3, against_reference("regular")),

@@ -122,9 +122,9 @@ def write_results(per_student, notes, out, feedback, backend):
                                                           encoding="utf-8")
     out.parent.mkdir(parents=True, exist_ok=True)
     with open(out, "w", newline="", encoding="utf-8") as handle:
-        writer = csv.DictWriter(handle, fieldnames=["student"] + [f"ex{n}" for n in
-                                                                  EXERCISE_NUMBERS]
-                                + ["total", "sandbox", "notes", "copied"])
+        columns = ["student", *(f"ex{n}" for n in EXERCISE_NUMBERS), "total", "sandbox", "notes",
+                   "copied"]
+        writer = csv.DictWriter(handle, fieldnames=columns)
         writer.writeheader()
         for row in rows:
             writer.writerow({k: (f"{v:g}" if isinstance(v, float) else cell(v))
