@@ -1,8 +1,8 @@
 """Marks only for the student's own code, in the checks' worker: foreign(namespace, names) says
-which graded names are not functions written in the notebook (their code must come from a
-`<cell N>`), and why - such a name gets 0. ikteach's own answers are not in the worker at all:
-its copy of ikteach has them as stubs that raise ReferenceBlocked (reference.py).
-"""
+which graded names are not functions written in the notebook (code from a `<cell N>`), and why:
+such a name gets 0. A cell can replace foreign(), as it can wrap anything in a one-line `def`:
+what holds is that ikteach's answers are not in the worker at all, only stubs that raise
+ReferenceBlocked (reference.py; tests/test_job.py forges foreign() and still gets 0)."""
 import functools
 import types
 
