@@ -11,7 +11,8 @@ import pytest
 import ikteach as ik
 from ikteach.course import check
 from ikteach.course.grading.cells import only_checks
-from ikteach.course.grading.extract import code_cells, python_source
+from ikteach.course.grading.extract import code_cells
+from cells_as_python import python_source
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES = {1: "_jacobian_cases", 2: "_jt_cases", 3: "_pinv_cases", 4: "_dls_cases",

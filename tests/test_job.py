@@ -252,6 +252,24 @@ def test_what_a_job_says_is_bounded(sandbox):
     assert result["score"] == 0 and len(json.dumps(result)) < 40_000, len(json.dumps(result))
 
 
+FORGED_FOREIGN = """\
+from ikteach.course.grading import own_code
+own_code.foreign = lambda namespace, names: {}  # the job's report of foreign names: forged
+jt_step = ik.jt_step
+"""
+
+
+def test_a_forged_report_of_foreign_names_gains_nothing(sandbox):
+    """own_code.foreign runs in the student's process, so a cell can replace it; that only
+    takes away the early 0 that a one-line `def` wrapper avoids anyway: the name is still
+    called in the job, where ikteach's answer is a stub that raises."""
+    result = grade.grade_book("forged.ipynb", with_answer(FORGED_FOREIGN), 60, 120, sandbox,
+                              seed=1)
+    assert result["score"] == 0, result
+    assert "`jt_step` raised ReferenceBlocked: ikteach's jt_step is the reference" in \
+        result["message"], result["message"]
+
+
 FLOOD = """\
 import json, os, signal
 signal.signal(signal.SIGALRM, signal.SIG_IGN)  # the notebook's own alarm: ignored

@@ -18,7 +18,8 @@ import pytest
 import ikteach
 from ikteach.course import check
 from ikteach.course.grading import reference, selfcheck
-from ikteach.course.grading.extract import code_cells, python_source
+from ikteach.course.grading.extract import code_cells
+from cells_as_python import python_source
 
 PACKAGE = Path(ikteach.__file__).resolve().parent
 ROOT = PACKAGE.parent

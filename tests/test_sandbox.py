@@ -14,6 +14,7 @@ import pytest
 
 from ikteach.course.grading import bwrap, extract
 from ikteach.course.grading.sandbox import Limits, Sandbox, SandboxUnavailable
+from cells_as_python import python_source
 from sandboxes import SANDBOXED
 
 PACKAGE = Path(__file__).resolve().parents[1] / "ikteach"
@@ -269,8 +270,8 @@ def test_code_cells_are_the_cells_text_and_magics_become_python():
     book = {"cells": [{"cell_type": "markdown", "source": "x"},
                       {"cell_type": "code", "source": ["a = 1\n", "b = 2"]}]}
     assert extract.code_cells(book) == [(2, "a = 1\nb = 2")]
-    assert "get_ipython()" in extract.python_source("%matplotlib inline\nx = 1\n")
-    assert extract.python_source("%%time\nx = 1\n") == "x = 1\n"
+    assert "get_ipython()" in python_source("%matplotlib inline\nx = 1\n")
+    assert python_source("%%time\nx = 1\n") == "x = 1\n"
 
 
 def test_the_seccomp_filter_refuses_locks_and_watches():

@@ -1,51 +1,29 @@
 """Grade the students' exercise notebooks.
 
-    python -m ikteach.course.grade SUBMISSIONS_DIR --out grades.csv [--feedback DIR] [--timeout S]
-                            [--grade-timeout S] [--jobs N] [--memory-mb M] [--tmpfs-mb T]
-                            [--seed N]
-                            [--no-sandbox]
+    python -m ikteach.course.grade SUBMISSIONS_DIR --out grades.csv [--jobs N] [...: --help]
     python -m ikteach.course.grade --gradescope OUT.zip      (a Gradescope autograder bundle)
 
-SUBMISSIONS_DIR holds one folder per student (the folder name is the student), each with that
-student's exercise notebooks. A notebook is taken for an exercise by its content (the
-functions it defines, the check it calls), else its metadata, else an NN_ in its name
-(grading/recognise.py).
-Each notebook is one job, in a sandbox (ikteach.course.grading.sandbox: bubblewrap, an
-unprivileged user without capabilities, no network, a read-only whitelist of the machine,
-resource limits; where no sandbox works the grader refuses unless --no-sandbox):
+SUBMISSIONS_DIR holds one folder per student (the folder name is the student) with that
+student's exercise notebooks, read as untrusted (grading/submissions.py: a bad entry costs only
+its student's marks, with a reason in the CSV's `notes`), each taken for an exercise by what it
+does (grading/recognise.py). Each notebook is one job in a sandbox (grading/sandbox.py; where
+none works the grader refuses unless --no-sandbox), a fresh child of a fork server no student
+code ran in (grading/forkserver.py), whose copy of ikteach has that exercise's answers as stubs
+that raise (grading/reference.py):
 
-1. its code cells run in IPython's shell, as a kernel runs them (grading/cells.py); their
-   errors are notes, nothing they print counts;
-2. then ik.check runs in the grader's own process on hidden cases (the instant check's kinds
-   with numbers drawn from a seed at grading time, logged; --seed repeats a run), calling the
-   functions the cells left in the shell's namespace through a pipe, each call under its time
-   limit (grading/remote.py): limits in CPU seconds of the job, so a machine's load changes
-   no mark ("this machine is busy" where a call waited far longer than its limit). So nothing
-   a notebook does to modules, builtins, stdout or files changes a score. A graded name that
-   is not a function written in the notebook gets 0 (grading/own_code.py). A notebook whose
-   call the checks' time limit stopped is graded again from scratch, in a fresh sandbox,
-   before the timeout counts.
-The job sees a copy of ikteach in which the exercise's reference answers are stubs that raise,
-without the checker and the self-check (grading/reference.py: what the grader guarantees and
-what it only reports - code copied from ikteach, in grades.csv's `copied`). It is a fresh child
-of a fork server (grading/forkserver.py: one per sandbox, exercise and grading process, Python,
-JAX and ikteach imported once), which no student code ever ran in; after each job every process
-of the sandbox but the server is killed and what they wrote removed, and a server the job
-changed (its files, limits or priorities) is replaced, so no notebook starts from a state
-another one touched.
+1. its code cells run in IPython's shell (grading/cells.py) within --timeout s; their errors
+   are notes, nothing they print counts;
+2. ik.check runs in the grader's own process on hidden cases (the check cell's, and as many
+   drawn from a seed logged at the start: --seed repeats a run), calling the functions the
+   cells left through a pipe (grading/remote.py), each call limited in CPU seconds of the job
+   (a machine's load changes no mark), all of them within --grade-timeout. A graded name that
+   is not a function written in the notebook gets 0 (grading/own_code.py); a notebook that a
+   check's time limit stopped is graded once more from a clean start before that counts.
 
-Before anyone is graded the sandbox is probed (the log states only what the probe saw hold)
-and a known-good answer must get full marks (grading/selfcheck.py); if either fails the grader
-stops with a non-zero exit status. The submissions folder is not trusted (grading/submissions.py):
-a symlink, FIFO, directory or malformed notebook costs only its student's marks, with a reason
-in the CSV's `notes`. Each notebook's cells get --timeout seconds (then the running cell is
-interrupted) and its checks --grade-timeout, both also enforced from outside the student's
-process (the fork server kills every process of the job; the grader kills the whole sandbox if
-the server does not answer).
-
-Writes one CSV row per student (ex1..ex7, total, sandbox, notes, copied) and a feedback file
-per student (FEEDBACK/<student>.txt, by default a `feedback` folder next to the CSV); the log
-starts with what the sandbox enforces and what it cannot on this machine.
+Before anyone is graded the sandbox is probed and a known-good answer must get full marks
+(grading/selfcheck.py), or the grader stops with a non-zero exit status. Writes one CSV row per
+student (ex1..ex7, total, sandbox, notes, copied) and a feedback file per student
+(grading/report.py; by default in a `feedback` folder next to the CSV).
 """
 import argparse
 import collections
@@ -61,8 +39,8 @@ from pathlib import Path
 
 from .exercises import ANSWER_PLACEHOLDER
 from .grading.recognise import exercise_number, identify  # noqa: F401 (grade.identify)
-from .grading.report import EXERCISE_NUMBERS, POINTS, RERUN, labels, write_results
-from .grading.submissions import MAX_NOTEBOOK_BYTES, notebooks, read_notebook, students, text
+from .grading.report import POINTS, RERUN, labels, write_results
+from .grading.submissions import notebooks, read_notebook, students, text
 
 NOTEBOOK_TIMEOUT = 120.0  # seconds for all of a student's cells
 GRADE_TIMEOUT = 180.0     # seconds for a notebook's checks: every call
@@ -70,8 +48,7 @@ GRACE = 15.0              # the fork server's kill comes first; then the grader 
 MAX_NOTEBOOKS = 3 * 7      # notebooks graded per student (the rest: a note)
 INSTRUCTOR = Path(__file__).resolve().parents[2] / "instructor"  # the solutions: hidden
 
-__all__ = ["grade_all", "grade_notebook", "grade_book", "exercise_number", "main",
-           "MAX_NOTEBOOK_BYTES"]
+__all__ = ["grade_all", "grade_notebook", "grade_book", "exercise_number", "main"]
 
 
 def _answer_text(book):
@@ -88,26 +65,13 @@ def _answer_text(book):
     return "\n".join(texts)[:4000]
 
 
-def _copied(number, held):
-    """Lines for the instructor: the notebook's functions whose code is exercise `number`'s
-    reference (`held`: the fingerprints of the code its cells' source defines, computed in a
-    job where no student code has run: nothing of a student's code is compiled here, nothing
-    is taken from the student's process). Reported, never scored (grading/reference.py)."""
-    from . import check
-    from .grading import reference
-
-    known = reference.reference_fingerprints(check.EXERCISES[number].REFERENCES)
-    return reference.copied(held, known)
-
-
 def _run(number, book, sandbox, timeout, grade_timeout, seed=None):
     """(verdict or None, notes, copied, stopped): the notebook's cells and then ik.check's
-    calls in one job (grading/cells.py), the verdict computed in this process on the hidden
-    cases drawn from `seed`, each call's limit counting the job's CPU seconds; notes: the
-    cells' errors and what went wrong on the way; stopped: a time limit of the checks ended a
-    call."""
+    calls in one job, the verdict computed here on the hidden cases drawn from `seed`; notes:
+    the cells' errors and what went wrong; stopped: a time limit of the checks ended a call."""
     from . import check
     from .check.verdicts import CPU_CLOCK
+    from .grading import reference
     from .grading.extract import code_cells
     from .grading.remote import ProcessEnded, Worker
 
@@ -123,7 +87,8 @@ def _run(number, book, sandbox, timeout, grade_timeout, seed=None):
             return (None, worker.errors + (worker.notes or [f"nothing could be graded: {exc}"]),
                     [], False)
         notes = worker.errors + worker.notes
-        copied = _copied(number, held)
+        # reported, never scored: the cells' source, fingerprinted where no student code ran
+        copied = reference.copied(held, reference.reference_fingerprints(module.REFERENCES))
         if worker.foreign:  # a graded name bound to ikteach's (or anyone's) code: no marks
             return (check.registry.refuse(number, " ".join(worker.foreign.values())), notes,
                     copied, False)
@@ -142,18 +107,15 @@ def _result(name, number=None, message=""):
 def grade_book(name, book, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT,
                sandbox=None, seed=None):
     """Grade one notebook (a dict) on the hidden cases drawn from `seed` (None: a fresh secret
-    one - never the instant check's public cases); returns a dict: file, exercise, how (how the
-    exercise was recognised), score, max, status, message, notes (what went wrong on the way),
-    answer (the written answer, if any), copied (functions whose code is ikteach's answer: for
-    the instructor), seed. A notebook whose call the checks' time limit stopped is run once
-    more, in a fresh sandbox, before the timeout costs marks."""
+    one); returns a dict: file, exercise, how (how the exercise was recognised), score, max,
+    status, message, notes (what went wrong on the way), answer (the written answer, if any),
+    copied (functions whose code is ikteach's answer: for the instructor), seed, seconds."""
     from .grading import servers
     from .grading.sandbox import Sandbox
 
     sandbox = sandbox or Sandbox()  # raises SandboxUnavailable where there is none
     number, how = identify(name, book)
-    result = _result(name, number)
-    result["how"] = how
+    result = dict(_result(name, number), how=how)
     result["seed"] = seed = secrets.randbits(63) if seed is None else int(seed)
     if number is None:
         result["message"] = ("not an exercise notebook (no ikteach exercise in its metadata, "
@@ -182,12 +144,9 @@ def grade_book(name, book, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT
     return result
 
 
-def grade_notebook(path, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT, sandbox=None,
-                   problem=None, seed=None):
-    """Grade one notebook file (read as untrusted: see grading/submissions.py)."""
-    from .grading.sandbox import Sandbox
-
-    sandbox = sandbox or Sandbox()  # raises SandboxUnavailable where there is none
+def grade_notebook(path, timeout, grade_timeout, sandbox, problem=None, seed=None):
+    """Grade one notebook file (read as untrusted: see grading/submissions.py) in `sandbox`
+    (`problem`: why it is not read, found when it was listed)."""
     path = Path(path)
     number = exercise_number(path, None)
     if problem is None:
@@ -291,9 +250,8 @@ def grade_all(submissions, out, feedback=None, timeout=NOTEBOOK_TIMEOUT, jobs=1,
             log(f"ignored (not a student folder): {text(name)}")
         jobs_list, per_student, notes = [], {}, {}
         for name, folder, problem in found:
-            per_student[name], notes[name] = [], []
+            per_student[name], notes[name] = [], [problem] if problem else []
             if problem:
-                notes[name].append(problem)
                 continue
             try:
                 books = notebooks(folder)

@@ -10,23 +10,16 @@ worth POINTS, split into parts; ``<name>_verdict(...)`` returns the Verdict with
 draw, and as many again drawn from the seed (the same kinds, other numbers).
 
 Layout: ``verdicts.py`` (running student code under a time limit, cases, comparisons, scoring
-by parts, the Verdict), one module per exercise (``ex01_jacobian.py`` ...), ``registry.py``
-(the exercise list, found from those files; grade()).
-
-To add exercise N, write ``exNN_<topic>.py`` (nothing else: ik.check.<name>, the grader's
-exercise numbers and grades.csv's columns derive from the files) with
-    NUMBER = N; CHECK_NAME = "<name>" (so ik.check.<name>); TITLE = "..."
-    FUNCTIONS = ("student_fn", ...)        # the names the template defines, in call order
-    REFERENCES = ("ikteach.core.x:fn", ...)  # ikteach's own answer: stubbed in the grader's
-                                           # sandbox (grading/reference.py)
-    def verdict(*functions, seed=None) -> Verdict   # cases: @_in_every_draw def cases(seed)
-                                           # (None: the check cell's; a seed: its own extra);
-                                           # build [_Part(name, points, run), ...] (points sum
-                                           # to POINTS; run() returns None or the message of
-                                           # the smallest failing case) and return
-                                           # _evaluate(NUMBER, TITLE, list(FUNCTIONS), parts)
-call student code only through verdicts._call (time limit, errors as messages). The grader
-then grades NN_*.ipynb.
+by parts, the Verdict), one module per exercise, ``registry.py`` (the exercise list; grade()).
+To add exercise N, write ``exNN_<topic>.py`` as the others are (nothing else: ik.check.<name>,
+the grader's exercise numbers and grades.csv's columns derive from the files): NUMBER,
+CHECK_NAME (ik.check.<CHECK_NAME>), TITLE, FUNCTIONS (the names the template defines, in call
+order), REFERENCES ("ikteach.core.x:fn": ikteach's own answer, stubbed in the grader's sandbox:
+grading/reference.py) and verdict(*functions, seed=None): its cases from an @_in_every_draw
+cases(seed) (None: the check cell's; a seed: its own on top), its parts [_Part(name, points,
+run), ...] (points summing to POINTS; run() returns None or the smallest failing case's
+message) handed to _evaluate(NUMBER, TITLE, list(FUNCTIONS), parts). Student code is called
+only through verdicts._answers or _call (time limit, errors as messages).
 """
 from . import registry, verdicts
 from .registry import EXERCISES, NUMBERS, grade

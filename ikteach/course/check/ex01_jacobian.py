@@ -7,15 +7,14 @@ import numpy as np
 
 from ...core.chain import planar_chain
 from ...core.jacobian import jacobian as _ref_jacobian
-from .verdicts import (_as_array, _call, _Case, _close, _evaluate, _Fail, _fmt, _in_every_draw,
+from .verdicts import (_answers, _Case, _close, _evaluate, _Fail, _fmt, _in_every_draw,
                        _mismatch, _Part, _rng, _shape_message)
 
 NUMBER = 1
 CHECK_NAME = "jacobian"
 TITLE = "the geometric Jacobian"
 FUNCTIONS = ("planar_jacobian",)
-# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
-REFERENCES = ("ikteach.core.jacobian:jacobian",
+REFERENCES = ("ikteach.core.jacobian:jacobian",  # ikteach's answers, stubbed when graded
               "ikteach.core.jacobian:jacobian_from_frames",
               "ikteach.core.jacobian:jacobian_autodiff",
               "ikteach.core.jacobian:jacobian_fd",
@@ -47,11 +46,9 @@ def _jacobian_cases(seed=None):
         n = int(rng.integers(1, 6))
         cases.append((rng.uniform(0.5, 1.5, n).round(3).tolist(),
                       rng.uniform(-np.pi, np.pi, n).round(3).tolist(), "regular"))
-    out = []
-    for k, (lengths, theta, tag) in enumerate(cases):
-        text = f"lengths = {_fmt(lengths)}, theta = {_fmt(theta)}"
-        out.append(_Case((lengths, theta), text, size=len(lengths) * 100 + k, tag=tag))
-    return sorted(out, key=lambda c: c.size)
+    return [_Case((lengths, np.array(theta)), f"lengths = {_fmt(lengths)}, theta = {_fmt(theta)}",
+                  size=len(lengths) * 100 + k, tag=tag)
+            for k, (lengths, theta, tag) in enumerate(cases)]
 
 
 def _jacobian_reference(lengths, theta):
@@ -59,24 +56,24 @@ def _jacobian_reference(lengths, theta):
 
 
 def _diagnose_jacobian(got, want, case):
+    detail = _mismatch(got, want, case, "J")
     if not np.all(np.isfinite(got)):
-        return f"your Jacobian contains NaN or inf.{_mismatch(got, want, case, 'J')}"
+        return "your Jacobian contains NaN or inf." + detail
     if _close(got, -want):
         return ("wrong sign: your Jacobian is -1 x the expected one. Column i is "
-                "z_i x (p_e - p_i) = z x (p_e - p_i) = (-(y_e - y_i), x_e - x_i)."
-                + _mismatch(got, want, case, "J"))
+                "z_i x (p_e - p_i) = z x (p_e - p_i) = (-(y_e - y_i), x_e - x_i)." + detail)
     for row, other, what in ((0, 1, "row 0 (x) is -(y_e - y_i)"), (1, 0, "row 1 (y) is x_e - x_i")):
         if _close(got[row], -want[row], scale=np.abs(want).max()) and _close(
                 got[other], want[other], scale=np.abs(want).max()):
             return (f"row {row} has the wrong sign (the other row is right): z x (p_e - p_i) = "
-                    f"(-(y_e - y_i), x_e - x_i), so {what}." + _mismatch(got, want, case, "J"))
+                    f"(-(y_e - y_i), x_e - x_i), so {what}." + detail)
     if _close(got, want[:, ::-1]):
         return ("the columns are in reverse order: column i belongs to joint i (J[:, 0] is "
-                "joint 1, at the base)." + _mismatch(got, want, case, "J"))
+                "joint 1, at the base)." + detail)
     if _close(got, want[::-1]):
-        return "rows swapped: row 0 is dx, row 1 is dy." + _mismatch(got, want, case, "J")
+        return "rows swapped: row 0 is dx, row 1 is dy." + detail
     return ("wrong values: column i should be z x (p_e - p_i), p_i the position of joint i "
-            "(p_1 = the base = row 0 of ik.joint_positions), p_e the end effector." + _mismatch(got, want, case, "J"))
+            "(p_1 = the base = row 0 of ik.joint_positions), p_e the end effector." + detail)
 
 
 def _columns_up_to_sign(got, want):
@@ -86,16 +83,10 @@ def _columns_up_to_sign(got, want):
         _close(g, w, scale=scale) or _close(g, -w, scale=scale) for g, w in zip(got.T, want.T))
 
 
-def _jacobian_parts(fn, name, seed=None):
-    cases = _jacobian_cases(seed)
-    cache = {}
-
-    def result(case):
-        if id(case) not in cache:
-            lengths, theta = case.args
-            cache[id(case)] = _as_array(_call(fn, name, case, list(lengths), np.array(theta)),
-                                        name, case)
-        return cache[id(case)]
+def verdict(planar_jacobian, seed=None):
+    """Verdict for exercise 1 without printing (`seed`: the grader's hidden cases)."""
+    name, cases = FUNCTIONS[0], _jacobian_cases(seed)
+    result = _answers(planar_jacobian, name)
 
     def compared(tag):
         """(case, got, want) of the cases with `tag`, shapes checked first."""
@@ -129,10 +120,6 @@ def _jacobian_parts(fn, name, seed=None):
                 return ("at a singular configuration (arm straight or folded): "
                         + _diagnose_jacobian(got, want, case))
 
-    return [_Part("shape", 2, shape), _Part("lever arms", 4, lever_arms),
-            _Part("sign", 2, sign), _Part("singular", 2, singular)]
-
-
-def verdict(planar_jacobian, seed=None):
-    """Verdict for exercise 1 without printing (`seed`: the grader's hidden cases)."""
-    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _jacobian_parts(planar_jacobian, FUNCTIONS[0], seed))
+    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), [
+        _Part("shape", 2, shape), _Part("lever arms", 4, lever_arms), _Part("sign", 2, sign),
+        _Part("singular", 2, singular)])

@@ -6,26 +6,15 @@ J J^T e = 0 2.
 import numpy as np
 
 from ...core.jt import jt_step as _ref_jt
-from .verdicts import (_as_array, _call, _Case, _close, _evaluate, _Fail, _in_every_draw,
-                       _matrix_text, _mismatch, _Part, _rng, _shape_message, _turned)
+from .verdicts import (_answers, _Case, _close, _evaluate, _Fail, _in_every_draw, _matrix_text,
+                       _mismatch, _Part, _rng, _shape_message, _turned_hand)
 
 NUMBER = 2
 CHECK_NAME = "jt_step"
 TITLE = "the Jacobian-transpose step"
 FUNCTIONS = ('jt_step',)
-# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
-REFERENCES = ("ikteach.core.jt:jt_step", "ikteach.core.jt:optimal_alpha")
-
-def _step_cases(rng, count=12, extra=()):
-    out = list(extra)
-    for k in range(count):
-        m = int(rng.integers(2, 4))
-        n = int(rng.integers(1, 6))
-        J = rng.normal(size=(m, n)).round(3)
-        e = rng.normal(size=m).round(3)
-        out.append(_Case((J, e), _matrix_text(J, e), size=m * n * 100 + 50 + k, tag="regular"))
-    return sorted(out, key=lambda c: c.size)
-
+REFERENCES = ("ikteach.core.jt:jt_step",  # ikteach's answers, stubbed when graded
+              "ikteach.core.jt:optimal_alpha")
 
 HAND = [(np.eye(2), np.array([1.0, 0.0]), "regular"),
         (np.array([[1.0, 0.0, 0.0], [0.0, 2.0, 0.0]]), np.array([1.0, 1.0]), "regular"),
@@ -34,29 +23,24 @@ HAND = [(np.eye(2), np.array([1.0, 0.0]), "regular"),
         (np.zeros((2, 3)), np.array([0.5, -0.5]), "zero")]
 
 
-def _hidden_hand(rng):
-    """HAND turned (verdicts._turned)."""
-    return [(*(x[0] for x in _turned(rng, [J], [e])), tag) for J, e, tag in HAND]
-
-
 @_in_every_draw
 def _jt_cases(seed=None):
     rng = _rng(seed, 2)
-    hand = []
-    for k, (J, e, tag) in enumerate(HAND if seed is None else _hidden_hand(rng)):
-        hand.append(_Case((J, e), _matrix_text(J, e), size=J.size * 100 + k, tag=tag))
-    return _step_cases(rng, extra=hand)
+    cases = [_Case((J, e), _matrix_text(J, e), size=J.size * 100 + k, tag=tag) for k, (J, e, tag)
+             in enumerate(HAND if seed is None else _turned_hand(rng, HAND))]
+    for k in range(12):
+        m = int(rng.integers(2, 4))
+        n = int(rng.integers(1, 6))
+        J = rng.normal(size=(m, n)).round(3)
+        e = rng.normal(size=m).round(3)
+        cases.append(_Case((J, e), _matrix_text(J, e), size=m * n * 100 + 50 + k, tag="regular"))
+    return cases
 
 
-def _jt_parts(fn, name, seed=None):
-    cases = _jt_cases(seed)
-    cache = {}
-
-    def result(case):
-        if id(case) not in cache:
-            J, e = case.args
-            cache[id(case)] = _as_array(_call(fn, name, case, J.copy(), e.copy()), name, case)
-        return cache[id(case)]
+def verdict(jt_step, seed=None):
+    """Verdict for exercise 2 without printing (`seed`: the grader's hidden cases)."""
+    name, cases = FUNCTIONS[0], _jt_cases(seed)
+    result = _answers(jt_step, name)
 
     def coefficient(case):
         """(c, along) with got = c J^T e when `along`."""
@@ -65,12 +49,9 @@ def _jt_parts(fn, name, seed=None):
         if got.shape != g.shape:
             raise _Fail(_shape_message(name, got, g, case, " - one entry per joint"))
         if not np.all(np.isfinite(got)):
-            raise _Fail(f"your step contains NaN or inf.{_mismatch(got, _ref(case), case)}")
+            raise _Fail(f"your step contains NaN or inf.{_mismatch(got, case.want(_ref_jt), case)}")
         c = float(got @ g / (g @ g))
         return c, _close(got, c * g)
-
-    def _ref(case):
-        return case.want(_ref_jt)
 
     regular = [c for c in cases if c.tag == "regular"]
 
@@ -79,7 +60,8 @@ def _jt_parts(fn, name, seed=None):
             c, along = coefficient(case)
             if not along:
                 return ("your step does not point along J^T e: the Jacobian-transpose step is "
-                        "delta_theta = alpha J^T e." + _mismatch(result(case), _ref(case), case))
+                        "delta_theta = alpha J^T e."
+                        + _mismatch(result(case), case.want(_ref_jt), case))
 
     def sign():
         for case in regular:
@@ -88,7 +70,7 @@ def _jt_parts(fn, name, seed=None):
                 return "your step is not alpha J^T e, so its sign cannot be checked yet."
             if c < 0:
                 return ("wrong sign: the step must go along +J^T e (downhill on 1/2 |e|^2), "
-                        "with alpha > 0." + _mismatch(result(case), _ref(case), case))
+                        "with alpha > 0." + _mismatch(result(case), case.want(_ref_jt), case))
 
     def alpha():
         found = []
@@ -120,7 +102,7 @@ def _jt_parts(fn, name, seed=None):
 
     def zero():
         for case in (c for c in cases if c.tag == "zero"):
-            got, want = result(case), _ref(case)
+            got, want = result(case), case.want(_ref_jt)
             if got.shape != want.shape:
                 return _shape_message(name, got, want, case, " - one entry per joint")
             if not np.all(np.isfinite(got)):
@@ -130,10 +112,6 @@ def _jt_parts(fn, name, seed=None):
             if not _close(got, want):
                 return ("where J J^T e = 0 the step must be zero." + _mismatch(got, want, case))
 
-    return [_Part("direction", 2, direction), _Part("sign", 3, sign), _Part("alpha", 3, alpha),
-            _Part("zero", 2, zero)]
-
-
-def verdict(jt_step, seed=None):
-    """Verdict for exercise 2 without printing (`seed`: the grader's hidden cases)."""
-    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _jt_parts(jt_step, FUNCTIONS[0], seed))
+    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), [
+        _Part("direction", 2, direction), _Part("sign", 3, sign), _Part("alpha", 3, alpha),
+        _Part("zero", 2, zero)])

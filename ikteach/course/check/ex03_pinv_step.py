@@ -7,21 +7,23 @@ guard for sigma_max = 0 (J = 0: nothing is kept) 2.
 import numpy as np
 
 from ...core.pinv import pinv_step as _ref_pinv
-from .verdicts import (_as_array, _call, _Case, _close, _evaluate, _Fail, _fmt, _in_every_draw,
+from .verdicts import (_answers, _Case, _close, _evaluate, _Fail, _fmt, _in_every_draw,
                        _matrix_text, _mismatch, _Part, _random_matrix, _rng, _shape_message,
-                       _turned, _with_singular_values)
+                       _turned_hand, _with_singular_values)
 
 NUMBER = 3
 CHECK_NAME = "pinv_step"
 TITLE = "the pseudoinverse step"
 FUNCTIONS = ('pinv_step',)
-# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
-REFERENCES = ("ikteach.core.pinv:pinv_step", "ikteach.core.pinv:pinv_two_rows",
+REFERENCES = ("ikteach.core.pinv:pinv_step",  # ikteach's answers, stubbed when graded
+              "ikteach.core.pinv:pinv_two_rows",
               "ikteach.core.priority:damped_pinv")  # damping 0: J^+
 FIXED_CUTOFFS = tuple(10.0 ** (-k / 4) for k in range(33))  # a step ignoring rcond
 SWAP_HINT = ("\n  hint: J (m x n) = U Sigma V^T with U m x k and V n x k: U^T takes e (m entries) "
              "and V gives delta_theta (n entries), delta_theta = V Sigma^+ U^T e. U and V "
              "swapped? (np.linalg.svd returns U, sigma and V^T.)")
+RELATIVE = ("the cut-off must be relative: drop sigma_i < rcond * sigma_max (the largest "
+            "singular value), not sigma_i < rcond.")
 
 
 def _singular_hand(rng):
@@ -54,7 +56,7 @@ def _pinv_cases(seed=None):
                            size=m * n * 100 + 50 + k, tag="regular"))
     singular = _singular_hand(_rng(None, 30))  # the seed's own: the same turned
     if seed is not None:
-        singular = [(*(x[0] for x in _turned(rng, [J], [e])), r) for J, e, r in singular]
+        singular = _turned_hand(rng, singular)
     for k, (J, e, rcond) in enumerate(singular):
         s = np.linalg.svd(J, compute_uv=False)
         cases.append(_Case((J, e, rcond), _matrix_text(J, e, f", rcond = {rcond:g}")
@@ -64,7 +66,7 @@ def _pinv_cases(seed=None):
     J, e = np.zeros((2, n)), np.array([1.0, -0.5]) * (1 if seed is None else rng.normal())
     cases.append(_Case((J, e, 1e-6), _matrix_text(J, e, ", rcond = 1e-06") + " (J = 0: sigma_max = 0)",
                        size=J.size * 100, tag="zero"))
-    return sorted(cases, key=lambda c: c.size)
+    return cases
 
 
 def _pinv_variant(J, e, cut, swapped=False):
@@ -82,18 +84,16 @@ def _relative(rcond):
 
 
 def _fixed_cutoff(results):
-    """(low, high): the fixed relative cut-offs (a grid from 1 to 1e-8, 4 per decade) that
-    give the student's step on every case of `results` ([(case, got)]), or None. The cases
+    """The fixed relative cut-offs (a grid from 1 to 1e-8, 4 per decade) that give the
+    student's step on every case of `results` ([(case, got)]), in words, or None. The cases
     cannot tell apart cut-offs between two of their singular value ratios: the message names
     the whole range, not one value of it."""
     fits = [c for c in FIXED_CUTOFFS
             if all(_close(np.abs(got), np.abs(_pinv_variant(*case.args[:2], _relative(c))))
                    for case, got in results)]
-    return (min(fits), max(fits)) if fits else None
-
-
-def _cutoff_text(fits):
-    low, high = fits
+    if not fits:
+        return None
+    low, high = min(fits), max(fits)
     if low == high:
         return f"a fixed relative cut-off of {low:.2g}"
     return f"a fixed relative cut-off (any between {low:.2g} and {high:.2g} fits these cases)"
@@ -102,45 +102,41 @@ def _cutoff_text(fits):
 def _diagnose(got, want, case):
     """What is wrong with a step that is not J^+ e (nor -J^+ e)."""
     J, e, rcond = case.args
+    detail = _mismatch(got, want, case)
     if not np.all(np.isfinite(got)):
         return ("NaN or inf at a singular J: 1/sigma for a tiny or zero sigma. "
-                "Drop 1/sigma_i (use 0) for sigma_i < rcond * sigma_max." + _mismatch(got, want, case))
+                "Drop 1/sigma_i (use 0) for sigma_i < rcond * sigma_max." + detail)
     swapped = _pinv_variant(J, e, _relative(rcond), swapped=True)
     if swapped is not None and (_close(got, swapped) or _close(got, -swapped)):
         return ("U and V swapped: delta_theta = V Sigma^+ U^T e (np.linalg.svd returns U, "
-                "sigma and V^T)." + _mismatch(got, want, case))
+                "sigma and V^T)." + detail)
     if not np.any(got) and np.linalg.norm(J, 2) < 1e-2:
         return ("your step is zero for a small J: the cut-off is relative, so J's largest "
-                "singular values are kept however small (a guard at a fixed sigma_max?)."
-                + _mismatch(got, want, case))
+                "singular values are kept however small (a guard at a fixed sigma_max?)." + detail)
     uncut = _pinv_variant(J, e, lambda s: s > 0)
     if _close(got, uncut, rtol=1e-4) and not _close(uncut, want, rtol=1e-4):
         return ("no cut-off: 1/sigma_i must be dropped for sigma_i < rcond * "
                 f"sigma_max; here your step is {np.linalg.norm(got):.3g} long (np.linalg.pinv(J) "
-                "keeps every sigma_i >= 1e-15 sigma_max)." + _mismatch(got, want, case))
+                "keeps every sigma_i >= 1e-15 sigma_max)." + detail)
     if _close(got, _pinv_variant(J, e, lambda s: s >= rcond)):
-        return ("the cut-off must be relative: drop sigma_i < rcond * sigma_max "
-                "(the largest singular value), not sigma_i < rcond." + _mismatch(got, want, case))
+        return RELATIVE + detail
     return ("wrong values: delta_theta = sum_i (u_i . e / sigma_i) v_i over the "
-            "sigma_i kept by the cut-off." + _mismatch(got, want, case))
+            "sigma_i kept by the cut-off." + detail)
 
 
-def _pinv_parts(fn, name, seed=None):
-    cases = _pinv_cases(seed)
-    cache = {}
+def verdict(pinv_step, seed=None):
+    """Verdict for exercise 3 without printing (`seed`: the grader's hidden cases)."""
+    name, cases = FUNCTIONS[0], _pinv_cases(seed)
+    answer = _answers(pinv_step, name)
 
     def result(case):
-        if id(case) not in cache:
-            J, e, rcond = case.args
-            try:
-                got = _call(fn, name, case, J.copy(), e.copy(), rcond)
-            except _Fail as exc:
-                shapes = ("mismatch in its core dimension", "not aligned", "shapes")
-                if type(exc) is _Fail and any(word in str(exc) for word in shapes):
-                    raise _Fail(str(exc) + SWAP_HINT) from None
-                raise
-            cache[id(case)] = _as_array(got, name, case)
-        return cache[id(case)]
+        try:
+            return answer(case)
+        except _Fail as exc:  # numpy's error for mismatched shapes: U and V swapped?
+            shapes = ("mismatch in its core dimension", "not aligned", "shapes")
+            if type(exc) is _Fail and any(word in str(exc) for word in shapes):
+                raise _Fail(str(exc) + SWAP_HINT) from None
+            raise
 
     def compared(tag, signed):
         """None, or the message of the first case of `tag` that fails (`signed`: the sign
@@ -160,13 +156,11 @@ def _pinv_parts(fn, name, seed=None):
             if tag == "cutoff" and all(  # every case: sigma_i < rcond dropped
                     _close(np.abs(g), np.abs(_pinv_variant(*c.args[:2], lambda s, r=c.args[2]:
                                                             s >= r))) for c, g in results):
-                return ("the cut-off must be relative: drop sigma_i < rcond * sigma_max "
-                        "(the largest singular value), not sigma_i < rcond."
-                        + _mismatch(got, want, case))
+                return RELATIVE + _mismatch(got, want, case)
             fixed = _fixed_cutoff(results) if tag == "cutoff" else None
             if fixed is not None:
                 return (f"your cut-off ignores `rcond`: on every case it drops what "
-                        f"{_cutoff_text(fixed)} drops; here rcond = {rcond:g}. Drop "
+                        f"{fixed} drops; here rcond = {rcond:g}. Drop "
                         "sigma_i < rcond * sigma_max with the rcond passed in."
                         + _mismatch(got, want, case))
             if tag == "zero":
@@ -176,12 +170,8 @@ def _pinv_parts(fn, name, seed=None):
                         + _mismatch(got, want, case))
             return _diagnose(got, want, case)
 
-    return [_Part("regular", 2, lambda: compared("regular", signed=False)),
-            _Part("sign", 3, lambda: compared("regular", signed=True)),
-            _Part("small sigma dropped", 3, lambda: compared("cutoff", signed=False)),
-            _Part("sigma_max = 0 guard", 2, lambda: compared("zero", signed=False))]
-
-
-def verdict(pinv_step, seed=None):
-    """Verdict for exercise 3 without printing (`seed`: the grader's hidden cases)."""
-    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _pinv_parts(pinv_step, FUNCTIONS[0], seed))
+    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), [
+        _Part("regular", 2, lambda: compared("regular", signed=False)),
+        _Part("sign", 3, lambda: compared("regular", signed=True)),
+        _Part("small sigma dropped", 3, lambda: compared("cutoff", signed=False)),
+        _Part("sigma_max = 0 guard", 2, lambda: compared("zero", signed=False))])

@@ -6,16 +6,15 @@ form is defined for a wide J, the n x n form for a tall one, where the other is 
 import numpy as np
 
 from ...core.dls import dls_step as _ref_dls
-from .verdicts import (_as_array, _call, _Case, _close, _evaluate, _Fail, _fmt, _in_every_draw,
+from .verdicts import (_answers, _Case, _close, _evaluate, _Fail, _fmt, _in_every_draw,
                        _matrix_text, _mismatch, _Part, _random_matrix, _rng, _shape_message,
-                       _turned)
+                       _turned_hand)
 
 NUMBER = 4
 CHECK_NAME = "dls_step"
 TITLE = "damped least squares"
 FUNCTIONS = ('dls_step', 'dls_step_normal')
-# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
-REFERENCES = ("ikteach.core.dls:dls_step",
+REFERENCES = ("ikteach.core.dls:dls_step",  # ikteach's answers, stubbed when graded
               "ikteach.core.dls:dls_step_normal",
               "ikteach.core.dls:dls_step_small",  # what ik.DLS runs on 2-3 rows
               "ikteach.core.dls:damped_step",  # ik.DLS's choice between the two
@@ -33,19 +32,13 @@ HAND = [(np.array([[0.0, 0.0], [3.0, 2.0]]), np.array([1.0, 0.5]), 0.5, "singula
          "wide J, small damping")]
 
 
-def _hidden_hand(rng):
-    """HAND turned (verdicts._turned), the same damping."""
-    return [(*(x[0] for x in _turned(rng, [J], [e])), lam, note) for J, e, lam, note in HAND]
-
-
 @_in_every_draw
 def _dls_cases(seed=None):
     rng = _rng(seed, 4)
-    cases = []
-    hand = HAND if seed is None else _hidden_hand(rng)
-    for k, (J, e, lam, note) in enumerate(hand):
-        cases.append(_Case((J, e, lam), _matrix_text(J, e, f", damping = {lam:g}")
-                           + (f" ({note})" if note else ""), size=J.size * 100 + k))
+    hand = HAND if seed is None else _turned_hand(rng, HAND)  # the same damping
+    cases = [_Case((J, e, lam), _matrix_text(J, e, f", damping = {lam:g}")
+                   + (f" ({note})" if note else ""), size=J.size * 100 + k)
+             for k, (J, e, lam, note) in enumerate(hand)]
     for k in range(12):
         m = int(rng.integers(2, 4))
         n = int(rng.integers(1, 7))
@@ -54,7 +47,7 @@ def _dls_cases(seed=None):
         lam = float(rng.choice([rng.uniform(0.05, 0.8), rng.uniform(1.3, 3.0)]).round(3))
         cases.append(_Case((J, e, lam), _matrix_text(J, e, f", damping = {lam:g}"),
                            size=m * n * 100 + 50 + k))
-    return sorted(cases, key=lambda c: c.size)
+    return cases
 
 
 @_in_every_draw
@@ -64,10 +57,8 @@ def _form_cases(seed=None):
     form. Each is then J^+ e."""
     rng = _rng(seed, 40)
     wide, tall = _random_matrix(rng, 2, 4).round(3), _random_matrix(rng, 4, 2).round(3)
-    return [_Case((wide, rng.normal(size=2).round(3), 0.0),
-                  _matrix_text(wide, np.zeros(2)).split(", e =")[0] + " (wide, full row rank)"),
-            _Case((tall, rng.normal(size=4).round(3), 0.0),
-                  _matrix_text(tall, np.zeros(4)).split(", e =")[0] + " (tall, full column rank)")]
+    return [_Case((J, rng.normal(size=len(J)).round(3), 0.0), f"J = {_fmt(J)} ({what})")
+            for J, what in ((wide, "wide, full row rank"), (tall, "tall, full column rank"))]
 
 
 NO_DAMPING = ("the damping is missing: your step is the undamped J^+ e (the least-squares step, "
@@ -77,56 +68,48 @@ FORMS = ("J^T (J J^T + lambda^2 I)^-1 e, the m x m solve", "(J^T J + lambda^2 I)
          "the n x n solve")
 
 
-def _dls_parts(fns, names, seed=None):
-    cases = _dls_cases(seed)
-    cache = {}
+def verdict(dls_step, dls_step_normal, seed=None):
+    """Verdict for exercise 4 without printing (`seed`: the grader's hidden cases)."""
+    names, cases = list(FUNCTIONS), _dls_cases(seed)
+    answers = [_answers(fn, name) for fn, name in zip([dls_step, dls_step_normal], names)]
 
-    def result(which, case):
-        key = (which, id(case))
-        if key not in cache:
-            J, e, lam = case.args
-            got = _call(fns[which], names[which], case, J.copy(), e.copy(), lam)
-            cache[key] = _as_array(got, names[which], case)
-        return cache[key]
-
-    def undamped(which):
+    def undamped(which, answered):
         """Is the answer the undamped J^+ e wherever the undamped form is defined (J of full
         row rank for the m x m form, of full column rank for the n x n one), on cases where
-        damping matters?"""
-        found = [(case, cache[(which, id(case))]) for case in cases if (which, id(case)) in cache
-                 and np.linalg.matrix_rank(case.args[0]) == case.args[0].shape[which]]
+        damping matters? (`answered`: [(case, answer)])"""
+        found = [(case, got) for case, got in answered
+                 if np.linalg.matrix_rank(case.args[0]) == case.args[0].shape[which]]
         plain = [np.linalg.pinv(c.args[0]) @ c.args[1] for c, _ in found]
         return bool(found) and all(_close(g, p) for (_, g), p in zip(found, plain)) and any(
             not _close(p, np.asarray(_ref_dls(*c.args))) for (c, _), p in zip(found, plain))
 
     def diagnose(which, got, want, case):
-        name = names[which]
+        name, detail = names[which], _mismatch(got, want, case)
         if not np.all(np.isfinite(got)):
             return ("NaN or inf near a singularity: with damping > 0, J J^T + "
-                    "lambda^2 I is always invertible - no pseudoinverse needed."
-                    + _mismatch(got, want, case))
+                    "lambda^2 I is always invertible - no pseudoinverse needed." + detail)
         if _close(got, np.asarray(_ref_dls(*case.args[:2], np.sqrt(case.args[2])))):
             return (f"missing square on lambda: `{name}` adds lambda I, the damping "
-                    "term is lambda^2 I (from lambda^2 |delta_theta|^2)."
-                    + _mismatch(got, want, case))
+                    "term is lambda^2 I (from lambda^2 |delta_theta|^2)." + detail)
         if _close(got, -want):
-            return "wrong sign." + _mismatch(got, want, case)
-        return f"wrong values: `{name}` should compute {FORMS[which]}." + _mismatch(
-            got, want, case)
+            return "wrong sign." + detail
+        return f"wrong values: `{name}` should compute {FORMS[which]}." + detail
 
     def form(which):
         name = names[which]
 
         def check():
             first = None  # (case, got or None, error or None): the smallest failing case
+            answered = []
             for case in cases:
                 try:
-                    got = result(which, case)
+                    got = answers[which](case)
                 except _Fail as exc:
                     if type(exc) is not _Fail:
                         raise
                     first = first or (case, None, str(exc))
                     continue
+                answered.append((case, got))
                 want = case.want(_ref_dls)
                 if got.shape != want.shape:
                     return _shape_message(name, got, want, case, " - one entry per joint")
@@ -134,11 +117,10 @@ def _dls_parts(fns, names, seed=None):
                     first = first or (case, got, None)
             if first is None:
                 return None
-            if undamped(which):
-                case, got, error = first
+            case, got, error = first
+            if undamped(which, answered):
                 return NO_DAMPING + (f"\n  smallest failing case: {case}\n  {error}" if error
                                      else _mismatch(got, case.want(_ref_dls), case))
-            case, got, error = first
             if error is not None:
                 raise _Fail(error)
             return diagnose(which, got, case.want(_ref_dls), case)
@@ -147,7 +129,7 @@ def _dls_parts(fns, names, seed=None):
     def both_forms():
         """The two agree, and each is its own form: at damping 0 only that form is defined."""
         for case in cases:
-            a, b = result(0, case), result(1, case)
+            a, b = answers[0](case), answers[1](case)
             if a.shape != b.shape or not _close(a, b):
                 return (f"your two forms disagree: `{names[0]}` and `{names[1]}` should give the "
                         "same step, (J^T J + lambda^2 I)^-1 J^T = J^T (J J^T + lambda^2 I)^-1."
@@ -157,8 +139,7 @@ def _dls_parts(fns, names, seed=None):
             which, (J, e, _) = k % 2, case.args  # wide, tall, wide, tall
             want, other = np.linalg.pinv(J) @ e, ("J^T J", "J J^T")[which]
             try:
-                got = _as_array(_call(fns[which], names[which], case, J.copy(), e.copy(), 0.0),
-                                names[which], case)
+                got = answers[which](case)
                 problem = None if _close(got, want) else f"your result: {_fmt(got)}"
             except _Fail as exc:
                 if type(exc) is not _Fail:
@@ -170,12 +151,6 @@ def _dls_parts(fns, names, seed=None):
                         f"singular. {problem}. The same form written twice? Write each form "
                         "as the exercise asks.")
 
-    return [_Part(names[0], 4, form(0)), _Part(names[1], 4, form(1)),
-            _Part("both forms", 2, both_forms)]
-
-
-def verdict(dls_step, dls_step_normal, seed=None):
-    """Verdict for exercise 4 without printing (`seed`: the grader's hidden cases)."""
-    names = list(FUNCTIONS)
-    return _evaluate(NUMBER, TITLE, names,
-                     _dls_parts([dls_step, dls_step_normal], names, seed))
+    return _evaluate(NUMBER, TITLE, names, [_Part(names[0], 4, form(0)),
+                                            _Part(names[1], 4, form(1)),
+                                            _Part("both forms", 2, both_forms)])

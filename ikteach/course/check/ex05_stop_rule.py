@@ -20,8 +20,7 @@ NUMBER = 5
 CHECK_NAME = "stop_rule"
 TITLE = "the out-of-reach stop rule"
 FUNCTIONS = ('stalled', 'stop_rule_step')
-# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
-REFERENCES = ("ikteach.core.stop_rules:joint_steps",
+REFERENCES = ("ikteach.core.stop_rules:joint_steps",  # ikteach's answers, stubbed when graded
               "ikteach.core.stop_rules:motion",
               "ikteach.core.stop_rules:step_size",
 )
@@ -32,20 +31,28 @@ STOP_THETA0 = [0.3, 0.2, 0.1]
 STOP_FRACTION = 1e-3
 STOP_MAX_ITER = 300
 STOP_DAMPING = 1.0            # enough damping for DLS to settle (exercise 6: less jitters)
+NEVER_STOPPED = ("the solve never stopped: when the rule fires, raise ik.StopSolve from your "
+                 "step function (ik.solve then ends \"stalled\").")
+
+
+def _total(lengths):
+    return float(np.sum(lengths))
+
+
+def _sums(d, lengths, fraction):
+    """The failing case's two sides of the rule, for the message."""
+    return (f"threshold: {fraction * sum(lengths):.4g}, sum |delta_theta_i| = "
+            f"{np.abs(d).sum():.4g}")
 
 
 def _stalled_reference(delta_theta, lengths, fraction):
     """The report's rule: stop when sum |delta_theta_i| < fraction * (total link length)."""
-    return float(np.sum(np.abs(delta_theta))) < fraction * float(np.sum(lengths))
+    return float(np.sum(np.abs(delta_theta))) < fraction * _total(lengths)
 
 
 # the step the student's stop rule wraps (a partial of ikteach's own function, so that the
 # grader can hand it to the student's code in another process by its name)
 _BASE_STEP = functools.partial(_ref_dls, damping=STOP_DAMPING)
-
-
-def _total(lengths):
-    return float(np.sum(lengths))
 
 
 _RULE_MISTAKES = [  # (a wrong rule, what to say), tried in this order against every case
@@ -103,15 +110,13 @@ def _stop_cases(seed=None):
         size = fraction * lengths.sum() * float(rng.choice([0.4, 2.5]))
         w = rng.dirichlet(np.ones(n)) * size * rng.choice([-1.0, 1.0], n)
         hand.append((w.tolist(), lengths.tolist(), fraction))
-    cases = [_Case((np.array(d), list(L), f),
-                   f"delta_theta = {_fmt(d)}, lengths = {_fmt(L)}, fraction = {f:g}",
-                   size=len(d) * 100 + k) for k, (d, L, f) in enumerate(hand)]
-    return sorted(cases, key=lambda c: c.size)
+    return [_Case((np.array(d), list(L), f),
+                  f"delta_theta = {_fmt(d)}, lengths = {_fmt(L)}, fraction = {f:g}",
+                  size=len(d) * 100 + k) for k, (d, L, f) in enumerate(hand)]
 
 
 def _as_bool(value, name, case):
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
+    """A True/False answer (a bool, or a number or 0-d array of one), or a _Fail."""
     arr = np.asarray(value) if value is not None else None
     if arr is not None and arr.shape == () and arr.dtype.kind in "biuf":
         return bool(arr)
@@ -122,9 +127,9 @@ def _as_bool(value, name, case):
 _EXPECTED_STOP = {}  # the reference's stalled solve (the same in every draw), run once
 
 
-def _stop_parts(stalled, stop_rule_step, seed=None):
-    names = ("stalled", "stop_rule_step")
-    arm_lengths, target, theta0 = STOP_ARM, STOP_TARGET, STOP_THETA0  # in every draw
+def verdict(stalled, stop_rule_step, seed=None):
+    """Verdict for exercise 5 without printing (`seed`: the grader's hidden cases)."""
+    names = FUNCTIONS
 
     def rule():
         cases = _stop_cases(seed)
@@ -137,9 +142,8 @@ def _stop_parts(stalled, stop_rule_step, seed=None):
             return None
         case, got = wrong[0]
         d, lengths, fraction = case.args
-        detail = (f"\n  smallest failing case: {case}\n  threshold: "
-                  f"{fraction * sum(lengths):.4g}, sum |delta_theta_i| = "
-                  f"{np.abs(d).sum():.4g}\n  expected {not got}, you returned {got}")
+        detail = (f"\n  smallest failing case: {case}\n  {_sums(d, lengths, fraction)}"
+                  f"\n  expected {not got}, you returned {got}")
         # the diagnosis: the known mistake that gives the student's answer on every case
         for mistake, advice in _RULE_MISTAKES:
             if all(got == mistake(*c.args) for c, got in zip(cases, answers)):
@@ -148,17 +152,17 @@ def _stop_parts(stalled, stop_rule_step, seed=None):
 
     def reference_step(J, e):
         delta = np.asarray(_BASE_STEP(J, e))
-        if _stalled_reference(delta, arm_lengths, STOP_FRACTION):
+        if _stalled_reference(delta, STOP_ARM, STOP_FRACTION):
             raise StopSolve("out of reach")
         return delta
 
     def run_solve(step, name):
-        case = (f"ik.solve(ik.planar_chain({arm_lengths}), target={target}, "
-                f"theta0={theta0}, method=your step, stall_tol=0)")
-        arm = planar_chain(arm_lengths)
+        case = (f"ik.solve(ik.planar_chain({STOP_ARM}), target={STOP_TARGET}, "
+                f"theta0={STOP_THETA0}, method=your step, stall_tol=0)")
+        arm = planar_chain(STOP_ARM)  # one arm and target, in every draw
 
         def go():
-            return _solve(arm, np.array(target), np.array(theta0), method=step,
+            return _solve(arm, np.array(STOP_TARGET), np.array(STOP_THETA0), method=step,
                           stall_tol=0.0, max_iter=STOP_MAX_ITER)
         try:
             return _call(go, name, case, limit=SOLVE_LIMIT), case
@@ -184,16 +188,12 @@ def _stop_parts(stalled, stop_rule_step, seed=None):
             except StopSolve:
                 if stop:
                     continue
-                return (f"your step function raised ik.StopSolve where the rule does not fire."
-                        f"\n  smallest failing case: {text}\n  threshold: "
-                        f"{fraction * sum(lengths):.4g}, sum |delta_theta_i| = "
-                        f"{np.abs(d).sum():.4g}: the step must go on")
+                return ("your step function raised ik.StopSolve where the rule does not fire."
+                        f"\n  smallest failing case: {text}\n  {_sums(d, lengths, fraction)}: "
+                        "the step must go on")
             if stop:
-                return ("the solve never stopped: when the rule fires, raise ik.StopSolve from "
-                        "your step function (ik.solve then ends \"stalled\")."
-                        f"\n  smallest failing case: {text}\n  threshold: "
-                        f"{fraction * sum(lengths):.4g}, sum |delta_theta_i| = "
-                        f"{np.abs(d).sum():.4g}: expected ik.StopSolve")
+                return (NEVER_STOPPED + f"\n  smallest failing case: {text}\n  "
+                        f"{_sums(d, lengths, fraction)}: expected ik.StopSolve")
             got = _as_array(got, "the step stop_rule_step returns", text)
             if not _close(got, d):
                 return (f"your step function must return the wrapped step's delta_theta "
@@ -204,10 +204,9 @@ def _stop_parts(stalled, stop_rule_step, seed=None):
         problem = wrapper_on_the_rules_cases()
         if problem is not None:
             return problem
-        case = (f"stop_rule_step(step, lengths={arm_lengths}, fraction={STOP_FRACTION:g}) "
+        case = (f"stop_rule_step(step, lengths={STOP_ARM}, fraction={STOP_FRACTION:g}) "
                 f"with step = DLS (damping {STOP_DAMPING:g})")
-        step = _call(stop_rule_step, names[1], case, _BASE_STEP, list(arm_lengths),
-                     STOP_FRACTION)
+        step = _call(stop_rule_step, names[1], case, _BASE_STEP, list(STOP_ARM), STOP_FRACTION)
         if not callable(step):
             return (f"`{names[1]}` must return a step function step(J, e) -> delta_theta; "
                     f"it returned {type(step).__name__}.")
@@ -221,14 +220,8 @@ def _stop_parts(stalled, stop_rule_step, seed=None):
         if got.status == "stalled" and abs(got.iterations - want) <= 1:
             return None
         if got.status == "max_iter":
-            return ("the solve never stopped: when the rule fires, raise ik.StopSolve from "
-                    "your step function (ik.solve then ends \"stalled\")." + detail)
+            return NEVER_STOPPED + detail
         return "the stop rule did not end the solve where it should." + detail
 
-    return [_Part("rule", 5, rule), _Part("solve", 5, solve_part)]
-
-
-def verdict(stalled, stop_rule_step, seed=None):
-    """Verdict for exercise 5 without printing (`seed`: the grader's hidden cases)."""
     return _evaluate(NUMBER, TITLE, list(FUNCTIONS),
-                     _stop_parts(stalled, stop_rule_step, seed))
+                     [_Part("rule", 5, rule), _Part("solve", 5, solve_part)])

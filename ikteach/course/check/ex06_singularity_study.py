@@ -13,14 +13,13 @@ from ...core.dls import dls_step as _ref_dls
 from ...core.jt import jt_step as _ref_jt
 from ...core.pinv import pinv_step as _ref_pinv
 from ...core.solve import solve as _solve
-from .verdicts import (_call, _evaluate, _Fail, _Part, SOLVE_LIMIT)
+from .verdicts import SOLVE_LIMIT, _call, _evaluate, _Fail, _Part
 
 NUMBER = 6
 CHECK_NAME = "singularity_study"
 TITLE = "a singularity study"
 FUNCTIONS = ('study',)
-# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
-REFERENCES = ()
+REFERENCES = ()  # ikteach's answers, stubbed when graded
 
 STUDY_ARM = [1.0, 1.0, 1.0]
 STUDY_THETA0 = [0.3, 0.2, 0.1]
@@ -82,9 +81,11 @@ def _same_answer(got, want):
         return False
 
 
-def _study_parts(study):
-    name = "study"
-    state = {}
+def verdict(study, seed=None):
+    """Verdict for exercise 6 without printing. `seed` is not used: the study's answers are
+    values read off the notebook's own runs (fixed arm and targets), so there are no hidden
+    cases - the instructor reads the code and the written answer."""
+    name, state = FUNCTIONS[0], {}
 
     def answers():
         if "answers" not in state:
@@ -94,8 +95,7 @@ def _study_parts(study):
                 raise _Fail(f"`{name}` must return a dict of answers, it returned "
                             f"{type(got).__name__}.")
             state["answers"] = got
-            state["reference"] = _reference_study()
-        return state["answers"], state["reference"]
+        return state["answers"], _reference_study()  # computed once (lru_cache)
 
     def question(key):
         points, meaning = _QUESTIONS[key]
@@ -109,11 +109,4 @@ def _study_parts(study):
                         f"{meaning} - run the solves and read it off the results.")
         return _Part(key, points, check)
 
-    return [question(key) for key in _QUESTIONS]
-
-
-def verdict(study, seed=None):
-    """Verdict for exercise 6 without printing. `seed` is not used: the study's answers are
-    values read off the notebook's own runs (fixed arm and targets), so there are no hidden
-    cases - the instructor reads the code and the written answer."""
-    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), _study_parts(study))
+    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), [question(key) for key in _QUESTIONS])

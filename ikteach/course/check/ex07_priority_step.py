@@ -7,15 +7,14 @@ no damping (lambda = 0, J1 singular or not: the exact pseudoinverses, finite) 2.
 import numpy as np
 
 from ...core.priority import priority_step as _ref_step
-from .verdicts import (_as_array, _call, _Case, _close, _evaluate, _Fail, _fmt, _in_every_draw,
+from .verdicts import (_answers, _Case, _close, _evaluate, _Fail, _fmt, _in_every_draw,
                        _mismatch, _Part, _rng, _shape_message, _turned)
 
 NUMBER = 7
 CHECK_NAME = "priority_step"
 TITLE = "the priority step"
 FUNCTIONS = ("priority_step",)
-# ikteach's own answer to this exercise: blocked (raises) while a student's code is graded
-REFERENCES = ("ikteach.core.priority:priority_step",
+REFERENCES = ("ikteach.core.priority:priority_step",  # ikteach's answers, stubbed when graded
               "ikteach.core.priority:multilevel_step",
               "ikteach.core.priority:null_space_step",
               "ikteach.core.priority:damped_pinv",  # the parts the exercise asks for
@@ -28,10 +27,6 @@ _AT_ZERO = ("With damping = 0, A^T (A A^T + lambda^2 I)^-1 is A^T (A A^T)^-1, wh
             "write the damped one from the SVD, V diag(sigma_i / (sigma_i^2 + lambda^2)) U^T with "
             "sigma_i below a small cut-off (e.g. 1e-10 sigma_max) dropped; it equals "
             "A^T (A A^T + lambda^2 I)^-1 for lambda > 0 and np.linalg.pinv(A) at lambda = 0.")
-
-
-def _ref_priority(J1, e1, J2, e2, lam):
-    return np.asarray(_ref_step(J1, e1, J2, e2, lam))  # one source: the module's own step
 
 
 def _damped(A, lam):
@@ -51,12 +46,6 @@ _DAMPING_MISTAKES = (  # (pseudoinverse used for J1 and for J2 N1, what is wrong
 )
 
 
-def _first_steps(J1, e1, lam):
-    """J1+ e1 damped with lambda^2 and with lambda (a slip in the damping, not in the
-    projection: the primary part keeps its points)."""
-    return [_damped(J1, lam) @ e1, _damped(J1, np.sqrt(lam)) @ e1]
-
-
 def _priority_variants(J1, e1, J2, e2, lam):
     """Common wrong steps, each with what it gets wrong."""
     n = J1.shape[1]
@@ -65,8 +54,7 @@ def _priority_variants(J1, e1, J2, e2, lam):
     N2 = np.eye(n) - np.linalg.pinv(J2) @ J2  # J2 N2 = 0: the same as ignoring the secondary
     rest = e2 - J2 @ first
     for damp, why in _DAMPING_MISTAKES:
-        J1_pinv = damp(J1, lam)
-        mine = J1_pinv @ e1
+        mine = damp(J1, lam) @ e1
         yield mine + N1 @ (damp(J2 @ N1, lam) @ (e2 - J2 @ mine)), why
     yield (first + _damped(J2, lam) @ rest,
            "the secondary step is not projected: J2+ (e2 - J2 J1+ e1) also moves the primary. "
@@ -97,8 +85,8 @@ def _primary_kept(got, J1, e1, lam):
     # J1 delta's rounding is relative to |J1| |delta| (the secondary's part is large where
     # e1 is small), not to J1 J1+ e1
     scale = np.linalg.norm(J1, 2) * max(np.abs(got).max(initial=0.0), 1e-300)
-    return any(_close(J1 @ got, J1 @ first, rtol=1e-6, atol=1e-8, scale=scale)
-               for first in _first_steps(J1, e1, lam))
+    return any(_close(J1 @ got, J1 @ (_damped(J1, d) @ e1), rtol=1e-6, atol=1e-8, scale=scale)
+               for d in (lam, np.sqrt(lam)))
 
 
 # rank 1 in its rounded entries as the hidden ones (an SVD leaves its second sigma at
@@ -156,7 +144,7 @@ def _priority_cases(seed=None):
         lam = round(float(rng.uniform(0.05, 0.8)), 3)
         cases.append(_Case((J1, e1, J2, e2, lam), _priority_text(J1, e1, J2, e2, lam),
                            size=n * (m1 + m2) * 100 + 50 + k, tag="regular"))
-    return sorted(cases, key=lambda c: c.size)
+    return cases
 
 
 def _priority_text(J1, e1, J2, e2, lam, note=""):
@@ -164,42 +152,36 @@ def _priority_text(J1, e1, J2, e2, lam, note=""):
             f"damping = {lam:g}" + (f" ({note})" if note else ""))
 
 
-def _priority_parts(fn, name, seed=None):
-    cases = _priority_cases(seed)
-    cache = {}
-
-    def result(case):
-        if id(case) not in cache:
-            J1, e1, J2, e2, lam = case.args
-            got = _call(fn, name, case, J1.copy(), e1.copy(), J2.copy(), e2.copy(), lam)
-            cache[id(case)] = _as_array(got, name, case)
-        return cache[id(case)]
+def verdict(priority_step, seed=None):
+    """Verdict for exercise 7 without printing (`seed`: the grader's hidden cases)."""
+    name, cases = FUNCTIONS[0], _priority_cases(seed)
+    result = _answers(priority_step, name)
 
     def diagnose(got, want, case):
         if got.shape != want.shape:
             return _shape_message(name, got, want, case, " - one entry per joint")
-        J1, e1, _, _, lam = case.args
+        (J1, e1, _, _, lam), detail = case.args, _mismatch(got, want, case)
         if not np.all(np.isfinite(got)):
             if lam == 0:
                 return ("your step is NaN or inf at damping = 0 where J1 is singular. "
-                        + _AT_ZERO + _mismatch(got, want, case))
+                        + _AT_ZERO + detail)
             return ("NaN or inf where J1 (or J2 N1) is singular: use damped pseudoinverses, "
                     "A^T (A A^T + lambda^2 I)^-1, which stay finite for damping > 0 (A A^T + "
-                    "lambda^2 I is then invertible)." + _mismatch(got, want, case))
+                    "lambda^2 I is then invertible)." + detail)
         for variant, why in _priority_variants(*case.args):
             if _close(got, variant) and not (lam == 0 and "damping" in why):
-                return why + _mismatch(got, want, case)
+                return why + detail
         if not _primary_kept(got, J1, e1, lam):
             return ("the primary task is disturbed: J1 delta_theta should equal J1 J1+ e1 "
                     "(the secondary may move only in J1's null space)."
                     + _mismatch(J1 @ got, J1 @ want, case, "J1 delta_theta"))
         return (f"wrong values: `{name}` should compute J1+ e1 + N1 (J2 N1)+ (e2 - J2 J1+ e1)."
-                + _mismatch(got, want, case))
+                + detail)
 
     def against_reference(tag):
         def check():
             for case in (c for c in cases if c.tag == tag):
-                got, want = result(case), case.want(_ref_priority)
+                got, want = result(case), case.want(_ref_step)
                 if not _close(got, want, rtol=1e-6, atol=1e-8):
                     return diagnose(got, want, case)
         return check
@@ -211,7 +193,7 @@ def _priority_parts(fn, name, seed=None):
                 got = result(case)
             except _Fail as exc:
                 return f"at damping = 0 {exc}.\n  " + _AT_ZERO
-            want = case.want(_ref_priority)
+            want = case.want(_ref_step)
             if not _close(got, want, rtol=1e-6, atol=1e-8):
                 problem = diagnose(got, want, case)
                 return problem if problem.startswith("your step is NaN") else "at damping = 0: " + problem
@@ -219,16 +201,10 @@ def _priority_parts(fn, name, seed=None):
     def primary_kept():
         """J1 delta = J1 J1+ e1: the secondary adds nothing the primary sees (first order)."""
         for case in (c for c in cases if c.tag != "no damping"):
-            J1, e1, J2, e2, lam = case.args
-            got = result(case)
-            if not _primary_kept(got, J1, e1, lam):
-                return diagnose(got, case.want(_ref_priority), case)
+            J1, e1, _, _, lam = case.args
+            if not _primary_kept(result(case), J1, e1, lam):
+                return diagnose(result(case), case.want(_ref_step), case)
 
-    return [_Part("primary kept", 3, primary_kept), _Part("secondary", 3, against_reference("regular")),
-            _Part("singular", 2, against_reference("singular")), _Part("no damping", 2, no_damping)]
-
-
-def verdict(priority_step, seed=None):
-    """Verdict for exercise 7 without printing (`seed`: the grader's hidden cases)."""
-    return _evaluate(NUMBER, TITLE, list(FUNCTIONS),
-                     _priority_parts(priority_step, "priority_step", seed))
+    return _evaluate(NUMBER, TITLE, list(FUNCTIONS), [
+        _Part("primary kept", 3, primary_kept), _Part("secondary", 3, against_reference("regular")),
+        _Part("singular", 2, against_reference("singular")), _Part("no damping", 2, no_damping)])

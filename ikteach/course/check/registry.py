@@ -28,19 +28,17 @@ def grade(number, namespace, seed=None):
     module = EXERCISES[number]
     missing = [n for n in module.FUNCTIONS if not callable(namespace.get(n))]
     if missing:
-        parts = [_Part("functions", POINTS, lambda: (
-            f"{', '.join('`' + n + '`' for n in missing)} not found in the notebook: keep the "
-            "function names of the template."))]
-        return _evaluate(number, module.TITLE, list(module.FUNCTIONS), parts)
+        return refuse(number, f"{', '.join('`' + n + '`' for n in missing)} not found in the "
+                      "notebook: keep the function names of the template.", part="functions")
     return module.verdict(*(namespace[n] for n in module.FUNCTIONS), seed=seed)
 
 
-def refuse(number, message):
-    """A 0 verdict for exercise `number` that says why (the grader's, e.g. a graded function
-    that is not the student's own code)."""
+def refuse(number, message, part="own code"):
+    """A 0 verdict for exercise `number` that says why in one failed `part` (the grader's,
+    e.g. a graded function that is not the student's own code)."""
     module = EXERCISES[number]
     return _evaluate(number, module.TITLE, list(module.FUNCTIONS),
-                     [_Part("own code", POINTS, lambda: message)])
+                     [_Part(part, POINTS, lambda: message)])
 
 
 class ReferenceBlocked(Exception):

@@ -1,10 +1,7 @@
 """The shared verdict machinery of ik.check: run student code safely, build cases, compare,
-score by parts, and word the one verdict a student sees.
-
-Every exercise module (ex01_jacobian.py, ...) builds a list of _Part(name, points, run) whose
-run() returns None (the part passed) or the message of its smallest failing case, and hands it
-to _evaluate(number, title, function_names, parts).
-"""
+score by parts (_Part, _evaluate: how an exercise module uses them is in check/__init__.py),
+and word the one verdict a student sees."""
+import collections
 import contextlib
 import contextvars
 import dataclasses
@@ -91,7 +88,8 @@ def _student_line(exc):
 
 
 def _call(fn, name, case, *args, limit=None):
-    """fn(*args) under a time limit; student errors become _NotYet/_Fail/_Abort."""
+    """fn(*args) under a time limit (None: TIME_LIMIT, read at the call); student errors
+    become _NotYet/_Fail/_Abort."""
     limit = TIME_LIMIT if limit is None else limit
     if not callable(fn):
         raise _Fail(f"expected your function `{name}`, got {type(fn).__name__} {fn!r:.40}")
@@ -135,6 +133,19 @@ def _as_array(value, name, case):
                     f"of the answer's size, which {raw.dtype} rounding does not always meet) "
                     f"on {case}")
     return arr
+
+
+def _answers(fn, name):
+    """answer(case): fn on copies of the case's arguments, as a float64 array (_as_array),
+    computed once per case (several parts ask for it)."""
+    cache = {}
+
+    def answer(case):
+        if id(case) not in cache:
+            args = [a.copy() if hasattr(a, "copy") else a for a in case.args]
+            cache[id(case)] = _as_array(_call(fn, name, case, *args), name, case)
+        return cache[id(case)]
+    return answer
 
 
 # --- cases and comparisons -------------------------------------------------------------------
@@ -218,6 +229,11 @@ def _turned(rng, Js, es):
             [scale * (P @ e) + 0.0 for P, e in zip(Ps, es)])
 
 
+def _turned_hand(rng, hand):
+    """Hand cases (J, e, anything else...) turned one by one (_turned), the rest kept."""
+    return [(*(x[0] for x in _turned(rng, [J], [e])), *rest) for J, e, *rest in hand]
+
+
 def _rng(seed, offset):
     """The cases' random generator: seed None gives the instant check's (SEED + offset: what a
     student sees in the notebook), an int the grader's added cases (drawn at grading time)."""
@@ -258,40 +274,31 @@ class Verdict:
     def passed(self):
         return self.status == "passed"
 
-    def summary(self):
-        """One line, for the grader's feedback file."""
-        return self.message.splitlines()[0]
-
     def __str__(self):
         return self.message
 
 
-class _Part:
-    def __init__(self, name, points, run):
-        self.name, self.points, self.run = name, points, run
+_Part = collections.namedtuple("_Part", "name points run")  # run() -> None or the message
 
 
 def _evaluate(number, name, function_names, parts):
     """Run every part; the first failure (smallest case) becomes the message."""
-    results, first_failure, not_yet = {}, None, set()
+    results, first_failure, not_yet = dict.fromkeys((p.name for p in parts), False), None, set()
     for part in parts:
         try:
             problem = part.run()
         except _NotYet as exc:
             not_yet.add(str(exc))
             problem = f"`{exc}` is not yet implemented (it raises NotImplementedError)."
-        except _Abort as exc:
-            results[part.name] = False
+        except _Abort as exc:  # the parts left stay failed
             first_failure = first_failure or str(exc)
-            for rest in parts[parts.index(part) + 1:]:
-                results[rest.name] = False
             break
         except _Fail as exc:
             problem = str(exc)
         results[part.name] = problem is None
         if problem is not None and first_failure is None:
             first_failure = problem
-    score = float(sum(p.points for p in parts if results.get(p.name)))
+    score = float(sum(p.points for p in parts if results[p.name]))
     total = float(sum(p.points for p in parts))
     title = f"Exercise {number} ({name})"
     if not_yet and score == 0 and not_yet >= set(function_names):
@@ -302,6 +309,6 @@ def _evaluate(number, name, function_names, parts):
     if first_failure is None:
         return Verdict(number, name, "passed", score, total,
                        f"{title}: passed, {score:g}/{total:g} - well done!", results)
-    marks = "  ".join(f"{p.name} {'ok' if results.get(p.name) else 'x'}" for p in parts)
+    marks = "  ".join(f"{p.name} {'ok' if results[p.name] else 'x'}" for p in parts)
     return Verdict(number, name, "failed", score, total,
                    f"{title}: {score:g}/{total:g} - {first_failure}\n  parts: {marks}", results)

@@ -1,8 +1,6 @@
 """A notebook's code cells as text (the grader runs them in IPython's shell: cells.py), and the
-same with IPython syntax turned into plain Python (for tools that compile a cell by itself).
-
-A cell magic that runs its body as the cell's own Python (%%time, %%capture) is taken off first.
-The transformer is slow on long runs of magics: it never runs in the grader's own process.
+same with magic and shell lines dropped (for the fingerprints, which compile a cell by itself);
+a cell magic that runs its body as the cell's own Python (%%time, %%capture) is taken off first.
 """
 import re
 
@@ -15,16 +13,6 @@ def cell_body(source):
     while match := BODY_AS_PYTHON.match(source):
         source = source[match.end():]
     return source
-
-
-def python_source(source):
-    """Cell source with IPython syntax (magics, !shell) rewritten as plain Python."""
-    source = cell_body(source)
-    try:
-        from IPython.core.inputtransformer2 import TransformerManager
-    except ImportError:  # no IPython: drop the magic lines instead
-        return without_magics(source)
-    return TransformerManager().transform_cell(source)
 
 
 def without_magics(source):

@@ -1,8 +1,8 @@
 """Marks only for the student's own code, in the checks' worker: foreign(namespace, names) says
-which graded names are not functions written in the notebook (their code must come from a
-`<cell N>`), and why - such a name gets 0. ikteach's own answers are not in the worker at all:
-its copy of ikteach has them as stubs that raise ReferenceBlocked (reference.py).
-"""
+which graded names are not functions written in the notebook (code from a `<cell N>`), and why:
+such a name gets 0. A cell can replace foreign(), as it can wrap anything in a one-line `def`:
+what holds is that ikteach's answers are not in the worker at all, only stubs that raise
+ReferenceBlocked (reference.py; tests/test_job.py forges foreign() and still gets 0)."""
 import functools
 import types
 
@@ -43,12 +43,6 @@ def _own(obj):
     return False
 
 
-def _where(obj):
-    module = getattr(obj, "__module__", None) or type(obj).__module__
-    name = getattr(obj, "__qualname__", None) or type(obj).__qualname__
-    return f"{module}.{name}"
-
-
 def foreign(namespace, names):
     """{name: why} for graded names bound to code not written in the notebook."""
     out = {}
@@ -56,7 +50,9 @@ def foreign(namespace, names):
         obj = namespace.get(name)
         if obj is None or not callable(obj) or _own(obj):
             continue  # missing or not callable: the check itself says so
+        where = (f"{getattr(obj, '__module__', None) or type(obj).__module__}."
+                 f"{getattr(obj, '__qualname__', None) or type(obj).__qualname__}")
         out[name] = (f"`{name}` is not a function written in your notebook: it is "
-                     f"{_where(obj)[:120]}. Marks are only for your own code - define "
+                     f"{where[:120]}. Marks are only for your own code - define "
                      f"`def {name}(...)` in the notebook and compute the answer there.")
     return out

@@ -39,10 +39,8 @@ def _from_content(book):
 
 
 def identify(path, book):
-    """(exercise number or None, how it was recognised): its content (the functions it
-    defines, the check it calls), else the notebook's metadata (ikteach.exercise: a student
-    who started exercise 3 from the exercise 2 file keeps exercise 2's), else an NN_ in its
-    file name."""
+    """(exercise number or None, how it was recognised), content first: a student who started
+    exercise 3 from the exercise 2 file keeps exercise 2's metadata (ikteach.exercise)."""
     meta = book.get("metadata") if isinstance(book, dict) else None
     meta = meta.get("ikteach") if isinstance(meta, dict) else None
     said = meta.get("exercise") if isinstance(meta, dict) else None

@@ -20,8 +20,8 @@ or pasted in). That is copying, which only a reader can judge; fingerprint() mak
 copy visible: a code object's operations, names, docstrings, file names and line numbers
 ignored, compared with the references' (copied(): what matched and how many operations), for
 the cells' source compiled in a job where no student code has run (source_fingerprints).
-Reordered, rewritten or split code, and code loaded at run time, is not seen. The
-work is bounded whatever a file holds (MAX_CODES, MAX_CODE_BYTES, MAX_TOTAL_BYTES).
+Reordered, rewritten or split code, and code loaded at run time, is not seen. The work is
+bounded whatever a file holds (MAX_CODES, MAX_CODE_BYTES, MAX_TOTAL_BYTES).
 """
 import ast
 import compileall
@@ -42,13 +42,6 @@ LEFT_OUT = ("course/check", "course/grade.py", "course/grading/selfcheck.py",
             "course/grading/gradescope.py", "course/grading/autograder.py")
 
 
-def _stub_body(qualname, exercise):
-    label = (f"ikteach's {qualname} is the reference answer of exercise {exercise}; graded "
-             "code must compute it itself")
-    return ast.parse("from ikteach.course.grading.own_code import ReferenceBlocked\n"
-                     f"raise ReferenceBlocked({label!r})\n").body
-
-
 def stub_source(source, names, exercise):
     """`source` (a module's text) with the top-level functions `names` raising instead; their
     signatures and decorators stay, so every caller (jit, a method table) still works."""
@@ -56,7 +49,10 @@ def stub_source(source, names, exercise):
     found = set()
     for node in tree.body:
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and node.name in names:
-            node.body = _stub_body(node.name, exercise)
+            label = (f"ikteach's {node.name} is the reference answer of exercise {exercise}; "
+                     "graded code must compute it itself")
+            node.body = ast.parse("from ikteach.course.grading.own_code import ReferenceBlocked"
+                                  f"\nraise ReferenceBlocked({label!r})\n").body
             found.add(node.name)
     if found != set(names):
         raise ValueError(f"references: {sorted(set(names) - found)} are not top-level "
@@ -113,7 +109,7 @@ MAX_CODE_BYTES = 16384   # longer code cannot be a reference's (the longest is ~
 MAX_CODES = 400          # code objects compared per notebook (the rest are not)
 MAX_TOTAL_BYTES = 1 << 20  # compiled code read per notebook, in all
 MAX_NAMES = 300          # names of one function followed (the instant check)
-MAX_REACHED = 20000      # objects followed from a namespace or a student's functions
+MAX_REACHED = 20000      # objects followed from a student's functions
 
 
 def _constant(const):
@@ -223,19 +219,13 @@ _LIBRARY = tuple({sys.prefix, sys.base_prefix, os.path.dirname(os.__file__)})
 _IKTEACH = str(Path(__file__).resolve().parents[2])  # ikteach/
 
 
-def _is_ikteach(obj):
-    module = str(getattr(obj, "__module__", "") or "")
-    code = getattr(obj, "__code__", None)
-    return module == "ikteach" or module.startswith("ikteach.") or (
-        code is not None and code.co_filename.startswith(_IKTEACH))
-
-
-def _entered(fn, into_ikteach):
-    """Is `fn`'s code followed? The student's (a cell's, the notebook's), and ikteach's when
-    `into_ikteach`; never a library's (numpy's, JAX's: they do not call ikteach)."""
-    if _is_ikteach(fn):
-        return into_ikteach
-    return not fn.__code__.co_filename.startswith(_LIBRARY)
+def _entered(fn):
+    """Is the function `fn`'s code followed? The student's (a cell's, the notebook's) and
+    ikteach's (a method object's step); never a library's (numpy's, JAX's: they do not call
+    ikteach)."""
+    module, file = str(getattr(fn, "__module__", "") or ""), fn.__code__.co_filename
+    return (module == "ikteach" or module.startswith("ikteach.") or file.startswith(_IKTEACH)
+            or not file.startswith(_LIBRARY))
 
 
 def _named(fn):
@@ -267,7 +257,7 @@ def _named(fn):
     return [v for v in found if not isinstance(v, types.ModuleType)]
 
 
-def _inner(obj, into_ikteach):
+def _inner(obj):
     inner = [getattr(obj, a, None) for a in ("__wrapped__", "__func__", "func")]
     if isinstance(obj, type):
         inner += list(vars(obj).values()) + [b for b in obj.__mro__[1:] if b is not object]
@@ -276,7 +266,7 @@ def _inner(obj, into_ikteach):
     elif isinstance(obj, dict):
         inner += list(obj.values())[:100]
     elif isinstance(obj, types.FunctionType):
-        if _entered(obj, into_ikteach):
+        if _entered(obj):
             inner += _named(obj)
             inner += list(obj.__defaults__ or ()) + list((obj.__kwdefaults__ or {}).values())
             inner += [_content(c) for c in obj.__closure__ or ()]
@@ -285,15 +275,14 @@ def _inner(obj, into_ikteach):
     return inner
 
 
-def _reachable(roots, into_ikteach=False, limit=MAX_REACHED, stop=frozenset()):
+def _reachable(roots, stop):
     """Every object `roots` lead to through what their code names: functions and their
     wrappers (jit, partial, bound methods, a callable's __call__), the globals, imports and
     attribute chains (ik.core.jt.jt_step) their code names, their defaults and closures,
-    classes' methods and bases, an object's class, containers' items. ikteach's own
-    functions are entered when `into_ikteach` (a method object's step), otherwise reached
-    only; library code is never entered, nor the objects whose ids are in `stop`."""
+    classes' methods and bases, an object's class, containers' items (_inner), at most
+    MAX_REACHED; library code is never entered, nor the objects whose ids are in `stop`."""
     seen, queue = {}, list(roots)
-    while queue and len(seen) < limit:
+    while queue and len(seen) < MAX_REACHED:
         obj = queue.pop()
         if obj is None or id(obj) in seen or isinstance(obj, (str, bytes, int, float)):
             continue
@@ -301,7 +290,7 @@ def _reachable(roots, into_ikteach=False, limit=MAX_REACHED, stop=frozenset()):
         if id(obj) in stop:
             continue
         try:
-            queue += _inner(obj, into_ikteach)
+            queue += _inner(obj)
         except Exception:  # noqa: BLE001 - a student's odd object: not entered
             continue
     return list(seen.values())
@@ -324,7 +313,7 @@ def reached(functions, references):
         module, name = ref.split(":")
         obj = getattr(importlib.import_module(module), name)
         targets.update({id(obj): ref, id(_python_function(obj)): ref})
-    found = _reachable(functions, into_ikteach=True, stop=frozenset(targets))
+    found = _reachable(functions, stop=frozenset(targets))
     return sorted({targets[id(o)] for o in found if id(o) in targets})
 
 

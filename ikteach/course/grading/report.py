@@ -2,11 +2,10 @@
 why a notebook was not graded, copied: graded code that is ikteach's own answer, for the
 instructor to judge) and one feedback file per student. Every text is printable UTF-8, no
 control or bidi character in it (grading/submissions.text; the feedback keeps its newlines),
-whatever the file names and notebooks held; no CSV cell starts a
-spreadsheet formula; each student's name is NFC-normalised, or written with escapes where two
-names differ only in normalisation, and with a hash of the folder's bytes where two still look
-alike (labels()): every folder its own row and feedback file; a feedback file name is short
-whatever the name's length."""
+whatever the file names and notebooks held; no CSV cell starts a spreadsheet formula; each
+student's name is NFC-normalised, or written with escapes where two names differ only in
+normalisation, and with a hash of the folder's bytes where two still look alike (labels()):
+every folder its own row and feedback file, whose name is short whatever the student's."""
 import csv
 import hashlib
 import os
@@ -59,7 +58,6 @@ def file_name(label):
     return raw[:MAX_FILE_NAME].decode("utf-8", "ignore") + "-" + digest + ".txt"
 
 
-
 def _feedback_text(student, results):
     lines = [f"Feedback for {student}", ""]
     by_number = _best(results)  # the CSV's choice
@@ -74,10 +72,8 @@ def _feedback_text(student, results):
         lines += [f"  not counted (the best notebook counts): {o['file']}: {o['score']:g}/"
                   f"{o['max']:g} - {o['message'].splitlines()[0][:200] if o['message'] else ''}"
                   for o in results if o["exercise"] == number and o is not r]
-        for line in r["message"].splitlines():
-            lines.append(f"  {line}")
-        for note in r["notes"]:
-            lines.append(f"  note: {note}")
+        lines += [f"  {line}" for line in r["message"].splitlines()]
+        lines += [f"  note: {note}" for note in r["notes"]]
         copied = r.get("copied", [])
         lines += [f"  for the instructor: {line}" for line in copied]
         if copied:
@@ -126,9 +122,9 @@ def write_results(per_student, notes, out, feedback, backend):
                                                           encoding="utf-8")
     out.parent.mkdir(parents=True, exist_ok=True)
     with open(out, "w", newline="", encoding="utf-8") as handle:
-        writer = csv.DictWriter(handle, fieldnames=["student"] + [f"ex{n}" for n in
-                                                                  EXERCISE_NUMBERS]
-                                + ["total", "sandbox", "notes", "copied"])
+        columns = ["student", *(f"ex{n}" for n in EXERCISE_NUMBERS), "total", "sandbox", "notes",
+                   "copied"]
+        writer = csv.DictWriter(handle, fieldnames=columns)
         writer.writeheader()
         for row in rows:
             writer.writerow({k: (f"{v:g}" if isinstance(v, float) else cell(v))

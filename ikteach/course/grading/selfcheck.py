@@ -1,15 +1,11 @@
 """The grader's self-check before it grades anyone: a known-good answer of exercise 2 (a
-notebook built here, so it needs no instructor folder) must get full marks through the same
-sandbox and job as every student; a known wrapper of ikteach's own jt_step must
-get none. Otherwise the grader cannot grade on this machine (its Python or packages not
-visible in the sandbox, a backend that fails, a reference that still answers) and stops
-before writing a CSV of wrong zeros.
-
-The known-good answer is the source of ikteach's own module of exercise 2's references (jt.py:
-jt_step, optimal_alpha), undecorated, as a cell (good_answer): the package holds no other
-answer, and the sandbox's copy of ikteach holds those functions only as stubs
-(grading/reference.py) - so the self-check also shows that code typed into a cell is graded
-while the library's own functions answer nothing.
+notebook built here: no instructor folder needed) must get full marks through the same sandbox
+and job as every student, and a wrapper of ikteach's own jt_step none; otherwise the grader
+cannot grade on this machine (its Python or packages not visible in the sandbox, a backend that
+fails, a reference that still answers) and stops before writing a CSV of wrong zeros. The
+known-good answer is ikteach's own jt.py as a cell (good_answer), while the sandbox's copy holds
+those functions only as stubs (grading/reference.py): so the self-check also shows that code
+typed into a cell is graded while the library's own functions answer nothing.
 """
 import ast
 import importlib
