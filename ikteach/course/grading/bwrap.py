@@ -111,9 +111,7 @@ def command(bwrap, flags, package, hidden, work, pid1=False, tmpfs_bytes=None, s
 
 
 def unprivileged(args):
-    """The bwrap command line `args`, started as host uid SANDBOX_ID when this process is root:
-    a bwrap as root that makes what `args` binds reachable for that uid (reachable()), then
-    the drop (_launch.py --as), then `args`."""
+    """`args` (a bwrap command line), started as uid SANDBOX_ID where this process is root."""
     if os.geteuid() != 0:
         return list(args)
     sources = [args[i + 1] for i, op in enumerate(args[:-1]) if op in ("--ro-bind", "--ro-bind-try")]

@@ -1,31 +1,16 @@
 """Each student process runs in a sandbox; without one the grader refuses to run student code
 (unless told: `unsandboxed=True`, the grader's --no-sandbox).
 
-Backend: bubblewrap (`bwrap`; Debian/Ubuntu/Fedora/Arch package `bubblewrap`), see bwrap.py. A
-run sees a read-only whitelist of the machine (system libraries, a few files of /etc, the
-Python the grader runs on, ikteach's package without its checker) and its own working folder;
-/tmp private; no network; own PID, IPC and UTS namespaces; its own user namespace as an
-unprivileged uid with no capabilities, and outside it an unprivileged uid too (a grader run as
-root starts bwrap as "nobody"); /proc/sys and the other
-parts of /proc that write to the machine's kernel read-only, and (Landlock, forkserver.py) no
-file outside its folders, /tmp and /dev/shm opens for writing: not its own oom_score_adj.
-What a run writes lives in memory, size-limited (tmpfs: /tmp, /dev/shm, its working folder;
-/dev read-only); POSIX message queues show in /dev/mqueue, so the fork server removes a job's;
-seccomp refuses new sessions (one scheduler autogroup per sandbox, not one per busy child), the
-kernel keyrings (not namespaced), file locks and inotify (a lock or a watch on a file every
-sandbox sees is a channel between jobs that run at once).
-Always: own HOME, bare environment (BLAS kernel variables passed through, so that the student's
-numbers come from the same kernels as the grader's), resource limits (CPU time, address space,
-file size, no core files), its own process group (ended as a whole, from outside), the OOM
-killer's first choice (oom_score_adj 1000: the grader survives a student's memory); where this
-process may make cgroups (v1 pids/memory/cpu, or v2), one per sandbox: processes (pids.max),
-memory of its processes and files together, an equal CPU share; else RLIMIT_NPROC (not for
-root).
-Student code runs in jobs of a fork server started in the sandbox (servers.py, forkserver.py):
-one bubblewrap per server, a fresh child per notebook (its cells, then its checks' calls),
-everything of a job killed and removed when it ends; a server a job changed is replaced.
+Backend: bubblewrap (`bwrap`; Debian/Ubuntu/Fedora/Arch package `bubblewrap`): what a run sees
+and may do is bwrap.py's command line, seccomp filter and drop of root. Always: own HOME, bare
+environment (BLAS kernel variables passed through: the student's numbers come from the grader's
+kernels), resource limits (CPU time, address space, file size, no core files), its own process
+group (ended as a whole, from outside), the OOM killer's first choice; where this process may
+make cgroups (v1 pids/memory/cpu, or v2), one per sandbox: processes, memory of its processes and
+files together, an equal CPU share; else RLIMIT_NPROC (not for root).
+Student code runs in jobs of a fork server started in the sandbox (servers.py, forkserver.py).
 `Sandbox.verify()` runs a probe as such a job and `report()` states only what the probe saw
-hold.
+hold (the lecturers' guide's table says the same, with each row's test).
 """
 import dataclasses
 import json
