@@ -10,7 +10,7 @@ settings.load_profile("ikteach")
 
 def pytest_configure(config):
     config.addinivalue_line("markers", "without_bwrap: its outcome depends on whether bubblewrap "
-                            "works (.ci/run runs them again, bwrap hidden from PATH, from the files it names)")
+                            "works (.ci/run runs them again with bwrap hidden from PATH)")
 
 
 # Wrong and hostile submissions for tests/test_grade.py: graded there, never run by nbval.

@@ -420,7 +420,8 @@ def test_without_a_sandbox_the_grader_refuses_and_grades_only_when_told(tmp_path
     own answer a stub in the copy PYTHONPATH names)."""
     subs, out = tmp_path / "subs", tmp_path / "out" / "grades.csv"
     for student, folder in (("solutions", ROOT / "instructor" / "solutions"),
-                            ("fixed_alpha", WRONG / "fixed_alpha"), ("ref_plain", WRONG / "ref_plain")):
+                            ("fixed_alpha", WRONG / "fixed_alpha"),
+                            ("ref_plain", WRONG / "ref_plain")):
         (subs / student).mkdir(parents=True)
         shutil.copy(folder / "02_jt_step.ipynb", subs / student)
     argv = [str(subs), "--out", str(out), "--no-bwrap", "--seed", str(HIDDEN_SEED)]
