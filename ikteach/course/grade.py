@@ -149,8 +149,10 @@ def grade_book(name, book, timeout=NOTEBOOK_TIMEOUT, grade_timeout=GRADE_TIMEOUT
     more, in a fresh sandbox, before the timeout costs marks."""
     from .grading import servers
     from .grading.sandbox import Sandbox
+    from .notebook import compilation_cache
 
     sandbox = sandbox or Sandbox()  # raises SandboxUnavailable where there is none
+    compilation_cache()  # the checks' compiled programs: loaded, not compiled, from a 2nd run
     number, how = identify(name, book)
     result = _result(name, number)
     result["how"] = how
