@@ -7,6 +7,12 @@ from hypothesis import settings  # noqa: E402
 settings.register_profile("ikteach", max_examples=25, deadline=None)
 settings.load_profile("ikteach")
 
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "without_bwrap: its outcome depends on whether bubblewrap "
+                            "works (.ci/run runs them again with bwrap hidden from PATH)")
+
+
 # Wrong and hostile submissions for tests/test_grade.py: graded there, never run by nbval.
 collect_ignore_glob = ["submissions/*"]
 

@@ -357,7 +357,8 @@ def test_every_path_to_the_reference_is_refused_by_the_instant_check(number, fun
                                                                       reference, marks):
     """Function-level imports, getattr with a name, attribute chains, method objects, the
     method table, a subclass, the lecture's parts of exercise 7: the grader's sandbox stubs
-    every one of them (test_reference_rule.py), so the instant check gives what it gives."""
+    every one of them (reference_spellings.py, graded in test_grade.py), so the instant check
+    gives what it gives."""
     module = check.EXERCISES[number]
     verdict = getattr(check, f"{module.CHECK_NAME}_verdict")(*functions)
     assert verdict.score == marks and reference in verdict.message, verdict.message

@@ -3,7 +3,8 @@ of attempt met in class gets the same marks from the check cell as from the grad
 cases under 40 seeds, and its message names the actual mistake. The deciding cases are the
 check cell's, in every draw (the seed only adds cases); float32 answers are refused alike; a
 function that reaches ikteach's own answer loses what the grader's stub makes it lose.
-(The grader's sandbox itself: test_reference_rule.py; verdicts here run in-process.)"""
+(The grader's sandbox itself: reference_spellings.py, graded in test_grade.py; verdicts here
+run in-process.)"""
 import json
 from pathlib import Path
 

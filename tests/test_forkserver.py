@@ -95,6 +95,7 @@ def attacked_book(shared, change):
 
 
 # /tmp's mode and the server folder's ACL only inside a sandbox (without one: the machine's own)
+@pytest.mark.without_bwrap
 @pytest.mark.parametrize("change", [None, "mode", "acl"] if shutil.which("bwrap") else [None])
 def test_what_a_notebook_leaves_does_not_reach_the_next(change):
     sandbox = _sandbox()

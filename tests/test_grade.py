@@ -1,5 +1,6 @@
 """python -m ikteach.course.grade on the solutions, the untouched templates, the wrong and the hostile
-submissions (tests/submissions/, written by make_hostile.py) and on a submissions folder that
+submissions (tests/submissions/, written by make_hostile.py), every spelling of ikteach's own
+answer (tests/reference_spellings.py: the reference rule) and on a submissions folder that
 is itself hostile (links, a FIFO, a directory named like a notebook, deep JSON, odd names).
 
 One grading run (two notebooks at a time) serves every test here. Where this machine has a
@@ -22,9 +23,11 @@ import time
 import unicodedata
 from pathlib import Path
 
+import numpy as np
 import pytest
 
-from ikteach.course import grade
+import reference_spellings as spellings
+from ikteach.course import check, grade
 from sandboxes import SANDBOXED
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -105,6 +108,7 @@ def graded(tmp_path_factory):
     for student in STUDENTS:
         shutil.copytree(WRONG / student, subs / student)
     (subs / "untouched" / "notes.txt").write_text("not a notebook: ignored")
+    spellings.write_class(subs)
     hostile_folder(subs)
     before = {p: p.read_bytes() for p in subs.rglob("*") if p.is_file() and not p.is_symlink()
               and not p.is_fifo()}
@@ -152,7 +156,7 @@ def test_one_row_and_one_feedback_file_per_student(graded):
     students = {"solutions", "untouched", "symlink_file", "symlink_folder", "device", "dir_named",
                 "fifo", "deep_json", "deep_dict", "odd_file_name", "surrogate",
                 "student-\\xff-name", LONG_NAME, "'" + FORMULA, "M\\xfcller", "Mu\\u0308ller",
-                "formula_file"} | set(STUDENTS)
+                "formula_file"} | set(STUDENTS) | {s[0] for s in spellings.SPELLINGS}
     assert set(graded.rows) == students  # the CSV's cell starts with ': no formula
     assert set(graded.feedback) == students - {"'" + FORMULA} | {FORMULA}
 
@@ -252,6 +256,33 @@ def test_marks_only_for_the_students_own_code(graded, student, exercise, line):
     marks, total = scores(graded.rows[student])
     assert marks[exercise - 1] == 0 and total == 0, graded.feedback[student]
     assert line in graded.feedback[student], graded.feedback[student]
+
+
+@pytest.mark.parametrize("student, number, source, marks, line, copied", spellings.SPELLINGS)
+def test_each_spelling_of_ikteachs_answer(graded, student, number, source, marks, line, copied):
+    row, feedback = graded.rows[student], graded.feedback[student]
+    assert float(row[f"ex{number}"]) == marks and float(row["total"]) == marks, feedback
+    assert line in feedback, feedback
+    if copied:
+        assert row["copied"].startswith(f"ex{number}: `") and line in row["copied"], row
+        assert "for the instructor: " in feedback
+        assert "the marks stand until the instructor decides" in feedback
+    else:
+        assert row["copied"] == "", row
+
+
+@pytest.mark.parametrize("student", spellings.AGREE)
+def test_instant_check_agrees(graded, student):
+    """The check cell gives what the grader gave, naming ikteach's function (issues 40, 48)."""
+    number, source, marks = next((n, src, m) for name, n, src, m, *_ in spellings.SPELLINGS
+                                 if name == student)
+    namespace = {"np": np, "ik": __import__("ikteach")}
+    exec(compile(source, "<cell 3>", "exec"), namespace)
+    module = check.EXERCISES[number]
+    verdict = getattr(check, f"{module.CHECK_NAME}_verdict")(
+        *(namespace[n] for n in module.FUNCTIONS))
+    assert verdict.score == float(graded.rows[student][f"ex{number}"]) == marks, verdict.message
+    assert "calls ikteach's own answer to this exercise" in verdict.message
 
 
 # issue 24, class 2: (student, the reason in the CSV's notes and the feedback)
@@ -381,6 +412,34 @@ def one_student(tmp_path):
     return subs, tmp_path / "out" / "grades.csv"
 
 
+@pytest.mark.without_bwrap
+def test_without_a_sandbox_the_grader_refuses_and_grades_only_when_told(tmp_path, capsys):
+    """bubblewrap not used (--no-bwrap; in .ci/run's second pass not on PATH either): exit
+    status 2, what to install, the override, no CSV. With --no-sandbox the class is graded
+    without isolation, the log and the CSV say so, and the marks are the sandbox's (ikteach's
+    own answer a stub in the copy PYTHONPATH names)."""
+    subs, out = tmp_path / "subs", tmp_path / "out" / "grades.csv"
+    for student, folder in (("solutions", ROOT / "instructor" / "solutions"),
+                            ("fixed_alpha", WRONG / "fixed_alpha"),
+                            ("ref_plain", WRONG / "ref_plain")):
+        (subs / student).mkdir(parents=True)
+        shutil.copy(folder / "02_jt_step.ipynb", subs / student)
+    argv = [str(subs), "--out", str(out), "--no-bwrap", "--seed", str(HIDDEN_SEED)]
+    assert grade.main(argv) == 2
+    err = capsys.readouterr().err
+    assert "no sandbox for the students' code" in err and "apt-get install bubblewrap" in err
+    assert "--no-sandbox" in err and not out.exists()
+    assert grade.main(argv + ["--no-sandbox"]) == 0
+    printed = capsys.readouterr()
+    assert "WARNING: --no-sandbox" in printed.err and "ISOLATION: NONE" in printed.out
+    rows = {r["student"]: r for r in csv.DictReader(out.open(encoding="utf-8"))}
+    assert {s: float(r["total"]) for s, r in rows.items()} == {
+        "solutions": 10.0, "fixed_alpha": 7.0, "ref_plain": 0.0}, printed.out
+    assert {r["sandbox"] for r in rows.values()} == {"none (--no-sandbox)"}
+    feedback = (out.parent / "feedback" / "ref_plain.txt").read_text(encoding="utf-8")
+    assert "raised ReferenceBlocked: ikteach's jt_step is the reference" in feedback, feedback
+
+
 @pytest.mark.parametrize("breakage", ["reference not blocked", "cells fail"])
 def test_a_failing_self_check_stops_before_grading_anyone(tmp_path, monkeypatch, capsys,
                                                           breakage):
@@ -404,6 +463,7 @@ def test_a_failing_self_check_stops_before_grading_anyone(tmp_path, monkeypatch,
     assert not out.exists()
 
 
+@pytest.mark.without_bwrap
 def test_packages_the_sandbox_does_not_show_stop_the_grader(tmp_path, monkeypatch, capsys):
     """The grader's packages hidden in the sandbox (as a venv it cannot see): exit status 2
     before anyone is graded. Without a sandbox: the refusal, also exit status 2."""

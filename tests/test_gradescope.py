@@ -56,6 +56,7 @@ def test_the_bundle_holds_the_scripts_and_no_solutions(bundle):
     assert "bubblewrap" in (source / "setup.sh").read_text()
 
 
+@pytest.mark.without_bwrap
 def test_a_solution_scores_full_marks(bundle, tmp_path):
     data = run_autograder(bundle[0], tmp_path, ROOT / "instructor" / "solutions" / "02_jt_step.ipynb")
     if data is None:
@@ -67,6 +68,7 @@ def test_a_solution_scores_full_marks(bundle, tmp_path):
     assert "passed, 10/10" in test["output"] and "sandbox: bubblewrap; enforced:" in data["output"]
 
 
+@pytest.mark.without_bwrap
 def test_a_wrong_submission_gets_its_marks_and_feedback(bundle, tmp_path):
     data = run_autograder(bundle[0], tmp_path, ROOT / "tests" / "submissions" / "fixed_alpha"
                           / "02_jt_step.ipynb")

@@ -55,6 +55,7 @@ def graded(tmp_path_factory):
     return rows, feedback, run.stdout
 
 
+@pytest.mark.without_bwrap  # without a sandbox: the class is refused (the fixture checks)
 def test_the_honest_classmate_keeps_full_marks_beside_a_cpu_storm(graded):
     if graded is None:
         return
@@ -76,6 +77,13 @@ def test_shell_escapes_are_skipped_with_bounded_notes(graded):
     took = re.search(r"shell_escapes/02_jt_step.ipynb: .* \((\d+) s\)", log)
     assert int(took.group(1)) <= TIMEOUT + GRADE_TIMEOUT + grade.GRACE, log
 
+
+def test_the_log_records_the_hidden_cases_seed(graded):
+    """Graded without --seed: a fresh secret seed, logged so that the run can be repeated."""
+    if graded is None:
+        return
+    seed = re.search(r"hidden cases: seed (\d+) \(--seed (\d+) grades on the same cases", graded[2])
+    assert seed and seed.group(1) == seed.group(2), graded[2]
 
 
 # --- graded as an ordinary user (issue 41): no cgroups, the process limit counted per user ------

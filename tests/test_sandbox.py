@@ -57,6 +57,7 @@ def sandbox(tmp_path):
     box.close()
 
 
+@pytest.mark.without_bwrap
 def test_limits_hold_with_and_without_isolation(sandbox, tmp_path):
     unsandboxed = Sandbox([], Limits(memory_mb=512, cpu_seconds=20), bwrap=False,
                           unsandboxed=True)
@@ -102,6 +103,7 @@ ATTACK = """
     """
 
 
+@pytest.mark.without_bwrap
 def test_a_student_process_cannot_escape_hide_or_regain_power(sandbox, tmp_path):
     """Writes outside (also where the grader imports from), hidden folders, the network,
     capabilities, mounts and new user namespaces - also when the grader runs as root."""
@@ -139,6 +141,7 @@ def test_a_student_process_cannot_escape_hide_or_regain_power(sandbox, tmp_path)
     assert out.count("no chmod /dev/") == 5, out
 
 
+@pytest.mark.without_bwrap
 def test_the_probe_catches_a_sandbox_that_does_not_hold(monkeypatch):
     """Take the network namespace away: verify() must refuse, not log "no network"."""
     if not SANDBOXED:

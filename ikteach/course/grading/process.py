@@ -32,14 +32,6 @@ class Process:
             tree += parents.get(pid, [])
         return total / os.sysconf("SC_CLK_TCK")
 
-    def wait(self, timeout):
-        """Its exit status, or None when it ran past `timeout` seconds (it is then ended)."""
-        try:
-            return self.proc.wait(timeout=timeout)
-        except subprocess.TimeoutExpired:
-            self.end()
-            return None
-
     def end(self):
         try:
             os.killpg(self.proc.pid, signal.SIGKILL)

@@ -75,7 +75,6 @@ class Server:
             why = (hello or {}).get("import_error") or self._stderr()
             self.stop()
             raise ServerFailed(why or "it ended without a word")
-        self.threads = hello.get("threads")
 
     def _stderr(self):
         try:

@@ -1,28 +1,19 @@
-"""The reference rule, graded as a class (issue 35): every spelling of "use ikteach's own
-answer" that the grader can stop scores nothing, because the sandbox of the graded exercise
-holds that answer only as a stub (grading/reference.py); the answers a notebook carries in
-itself (a marshalled blob, source typed in) are reported in grades.csv's `copied` column and
-the feedback, for the instructor; a lookup table of the instant check's cases meets hidden
-cases. The class gets its grades.csv (that the instructor's solutions keep 70/70 and are not
-reported, beside hostile students, is tests/test_grade.py's). Without bubblewrap the same run is made with --no-sandbox (the copy of
-ikteach is then what PYTHONPATH points at)."""
+"""The reference rule's students (issue 35), graded in tests/test_grade.py's class: every
+spelling of "use ikteach's own answer" that the grader can stop scores nothing, because the
+sandbox of the graded exercise holds that answer only as a stub (grading/reference.py); the
+answers a notebook carries in itself (a marshalled blob, source typed in) are reported in
+grades.csv's `copied` column and the feedback, for the instructor; a lookup table of the
+instant check's cases meets hidden cases. Without bubblewrap the class is graded with
+--no-sandbox (the copy of ikteach is then what PYTHONPATH points at)."""
 import base64
-import csv
 import inspect
-import json
 import marshal
-import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import nbformat
-import numpy as np
-import pytest
 
 from ikteach.core import pinv
 from ikteach.course import check
-from sandboxes import SANDBOXED
 
 ROOT = Path(__file__).resolve().parents[1]
 SOLUTIONS = ROOT / "instructor" / "solutions"
@@ -133,12 +124,12 @@ def jt_step(J, e):
 
 
 def fingerprint_stall():
-    """An honest jt_step beside 0.4 MB crafted against the copied report: deeply nested
-    lambdas, many functions, big constants (reference.py bounds the work on it)."""
+    """0.4 MB crafted against the copied report, in a cell after an honest jt_step's: deeply
+    nested lambdas, many functions, big constants (reference.py bounds the work on it)."""
     nested = "_f{i} = " + "lambda x: x * 3 - x ** 2 + (" * 60 + "1" + ")" * 60 + "\n"
     many = "def _g{i}(x):\n    return x * {i} + x ** 2 - abs(x) / 7 - max(x, {i}) * 3\n"
     big = "_t{i} = " + repr(tuple(range(300))) + "\n"
-    parts, i = [HONEST_JT], 0
+    parts, i = [], 0
     while sum(map(len, parts)) < 400_000:
         parts += [nested.format(i=i), many.format(i=i), big.format(i=i)]
         i += 1
@@ -216,67 +207,27 @@ AGREE = ("import_inside", "attribute_chain", "method_object", "lecture_parts",
          "method_object_one")
 
 
-def write_student(subs, student, number, source):
+def write_student(subs, student, number, source, after=None):
+    """The solution of exercise `number` with its function's cell replaced by `source` (and a
+    cell `after` it)."""
     path = next(SOLUTIONS.glob(f"{number:02d}_*.ipynb"))
     book = nbformat.read(path, as_version=4)
     name = FUNCTION[number]
-    for cell in book.cells:
+    for i, cell in enumerate(book.cells):
         if cell.cell_type == "code" and f"def {name}(" in cell.source:
             cell.source = source
+            if after:
+                book.cells.insert(i + 1, nbformat.v4.new_code_cell(after))
+            break
     (subs / student).mkdir()
     nbformat.write(book, subs / student / path.name)
 
 
-@pytest.fixture(scope="module")
-def graded(tmp_path_factory):
-    base = tmp_path_factory.mktemp("reference-rule")
-    subs = base / "submissions"
-    subs.mkdir()
+def write_class(subs):
+    """A folder per spelling in `subs`."""
     sources = {"marshal_blob": marshal_blob(), "typed_in": by_hand(),
                "typed_in_forged": FORGE_FINGERPRINTS + by_hand(),
-               "lookup_table": lookup_table(), "fingerprint_stall": fingerprint_stall()}
+               "lookup_table": lookup_table(), "fingerprint_stall": HONEST_JT}
     for student, number, source, *_ in SPELLINGS:
-        write_student(subs, student, number, source or sources[student])
-    out = base / "out" / "grades.csv"
-    command = [sys.executable, "-m", "ikteach.course.grade", str(subs), "--out", str(out),
-               "--timeout", "30", "--grade-timeout", "60", "--jobs", "2"]
-    run = subprocess.run(command + ([] if SANDBOXED else ["--no-sandbox"]), capture_output=True,
-                         text=True, timeout=900, cwd=base)
-    assert run.returncode == 0, run.stderr[-3000:]
-    rows = {r["student"]: r for r in csv.DictReader(out.open(encoding="utf-8"))}
-    feedback = {p.stem: p.read_text(encoding="utf-8") for p in (base / "out" / "feedback").glob("*.txt")}
-    return rows, feedback, run.stdout
-
-
-@pytest.mark.parametrize("student, number, source, marks, line, copied", SPELLINGS)
-def test_each_spelling_of_ikteachs_answer(graded, student, number, source, marks, line, copied):
-    rows, feedback, _ = graded
-    row = rows[student]
-    assert float(row[f"ex{number}"]) == marks and float(row["total"]) == marks, feedback[student]
-    assert line in feedback[student], feedback[student]
-    if copied:
-        assert row["copied"].startswith(f"ex{number}: `") and line in row["copied"], row
-        assert "for the instructor: " in feedback[student]
-        assert "the marks stand until the instructor decides" in feedback[student]
-    else:
-        assert row["copied"] == "", row
-
-
-def test_the_log_records_the_hidden_cases_seed(graded):
-    _, _, log = graded
-    assert "hidden cases: seed " in log and "--seed " in log
-
-
-@pytest.mark.parametrize("student", AGREE)
-def test_instant_check_agrees(graded, student):
-    """The check cell gives what the grader gave, naming ikteach's function (issues 40, 48)."""
-    rows, _, _ = graded
-    number, source = next((n, src) for name, n, src, *_ in SPELLINGS if name == student)
-    namespace = {"np": np, "ik": __import__("ikteach")}
-    exec(compile(source, "<cell 3>", "exec"), namespace)
-    module = check.EXERCISES[number]
-    verdict = getattr(check, f"{module.CHECK_NAME}_verdict")(
-        *(namespace[n] for n in module.FUNCTIONS))
-    marks = next(m for name, _, _, m, *_ in SPELLINGS if name == student)
-    assert verdict.score == float(rows[student][f"ex{number}"]) == marks, verdict.message
-    assert "calls ikteach's own answer to this exercise" in verdict.message
+        write_student(subs, student, number, source or sources[student],
+                      after=fingerprint_stall() if student == "fingerprint_stall" else None)
