@@ -1,9 +1,10 @@
 """Grading time for a class: N students x 6 exercise notebooks, python -m ikteach.course.grade --jobs J.
 
-    .venv/bin/python benchmarks/grade_class.py [--students 30] [--jobs 2] [--exercises 6]
+    .venv/bin/python benchmarks/grade_class.py [--students 30] [--jobs 2] [--exercises 6] [--solved]
 
 Each student folder holds exercises 1..6: the instructor's solution for some, the untouched
-template for others (a fixed pattern, so every run grades the same class). Prints the wall
+template for others (a fixed pattern, so every run grades the same class; --solved: every
+notebook the solution, the honest class of the grader's issues). Prints the wall
 time (start-up, probe and self-check included), seconds per notebook and the score totals
 (which the pattern fixes), and a reference loop's time before and after (this shared 2-core
 machine's speed drifts: compare runs only with similar loop times). `--label` names the row,
@@ -23,7 +24,7 @@ SOLUTIONS = ROOT / "instructor" / "solutions"
 TEMPLATES = ROOT / "notebooks" / "exercises"
 
 
-def build_class(folder, students, exercises):
+def build_class(folder, students, exercises, solved_only=False):
     """Student s gets the solution of exercise e when (s + e) % 3 != 0, else the template."""
     books = sorted(p.name for p in SOLUTIONS.glob("*.ipynb"))[:exercises]
     solved = 0
@@ -31,7 +32,7 @@ def build_class(folder, students, exercises):
         student = folder / f"student{s:02d}"
         student.mkdir(parents=True)
         for e, name in enumerate(books):
-            source = SOLUTIONS if (s + e) % 3 else TEMPLATES
+            source = SOLUTIONS if (s + e) % 3 or solved_only else TEMPLATES
             solved += source is SOLUTIONS
             shutil.copy(source / name, student / name)
     return len(books), solved
@@ -50,11 +51,13 @@ def main():
     ap.add_argument("--exercises", type=int, default=6)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--label", default="")
+    ap.add_argument("--solved", action="store_true", help="every notebook the solution")
     args = ap.parse_args()
     loop_before = loop_seconds()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        n_books, solved = build_class(tmp / "class", args.students, args.exercises)
+        n_books, solved = build_class(tmp / "class", args.students, args.exercises,
+                                       args.solved)
         out = tmp / "out" / "grades.csv"
         t0 = time.perf_counter()
         run = subprocess.run([sys.executable, "-m", "ikteach.course.grade", str(tmp / "class"),
