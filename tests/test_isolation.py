@@ -135,8 +135,7 @@ def graded_as_user():
     if not SANDBOXED or os.geteuid() != 0:
         pytest.skip("needs root (to become an ordinary user) and bubblewrap")
     # where the Python lies under a folder the user cannot enter (/root), it is shown to it
-    as_user = bwrap.reachable(shutil.which("bwrap"), [sys.base_prefix], USER) + [
-        sys.executable, "-S", str(bwrap.LAUNCH), "--as", str(USER), "--"]
+    as_user = bwrap.started_as(USER, shutil.which("bwrap"), [sys.base_prefix])
     seen = subprocess.run(as_user + [sys.executable, "-S", "-c",
                                      "import os, sys; print(os.getuid(), sys.base_prefix)"],
                           capture_output=True, text=True, timeout=60)

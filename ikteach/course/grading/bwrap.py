@@ -115,19 +115,30 @@ def unprivileged(args):
     if os.geteuid() != 0:
         return list(args)
     sources = [args[i + 1] for i, op in enumerate(args[:-1]) if op in ("--ro-bind", "--ro-bind-try")]
-    return (reachable(args[0], sources, int(SANDBOX_ID))
-            + [sys.executable, "-S", str(LAUNCH), "--as", SANDBOX_ID, "--", *args])
+    return started_as(int(SANDBOX_ID), args[0], sources) + list(args)
+
+
+def started_as(uid, bwrap, sources):
+    """The prefix (this process being root) that starts a command as `uid`, with `sources`
+    reachable for it (reachable()), then the drop (_launch.py --as)."""
+    return reachable(bwrap, sources, uid) + [sys.executable, "-S", str(LAUNCH), "--as", str(uid),
+                                             "--"]
 
 
 def reachable(bwrap, sources, uid):
     """[] where `uid` reaches each of `sources`; else bwrap ... -- (a command follows): as
     root, a mount namespace where a folder it cannot enter on the way (such as /root) is a
     tmpfs holding only the paths to those sources."""
-    closed = lambda p: os.stat(p).st_uid != uid and not os.stat(p).st_mode & 0o001  # noqa: E731
+    def closed(folder):
+        st = os.stat(folder)
+        return st.st_uid != uid and not st.st_mode & 0o001
+
     outer, made = [bwrap, "--dev-bind", "/", "/", "--chdir", "/", "--die-with-parent"], set()
     for source in map(Path, sources):
+        if not source.exists():
+            continue
         shut = next((p for p in reversed(source.parents) if closed(p)), None)
-        if shut is None or not source.exists():
+        if shut is None:
             continue
         for folder in [shut, *reversed(source.parents[:source.parents.index(shut)])]:
             if folder not in made:

@@ -147,7 +147,7 @@ class Server:
         self.libc = _libc()
         self.home = os.getcwd()  # the server's own folder (bound read-write)
         self.pid1 = os.getpid() == 1
-        self.baseline, self.state = None, None
+        self.baseline, self.state, self.times = None, None, {}
 
     def start(self):
         import resource
@@ -162,7 +162,8 @@ class Server:
             if not self.pid1:
                 raise RuntimeError("the fork server must be PID 1 of its sandbox")
             self.baseline = _state(SHARED, self.home)
-            self.times = {p: (os.lstat(p).st_atime_ns, os.lstat(p).st_mtime_ns) for p in self.baseline}
+            self.times = {p: (st.st_atime_ns, st.st_mtime_ns)
+                          for p, st in ((p, os.lstat(p)) for p in self.baseline)}
         self.state = own_state(self.libc)
 
     def send(self, message):
