@@ -4,8 +4,9 @@ cache (a student's first run on Colab or Binder), then again with the cache that
 
     .venv/bin/python benchmarks/compile_counts.py [notebooks/0*.ipynb ...]
 
-The program counts are deterministic; tests/test_compile_budget.py holds each lecture to its
-budget (ikteach/course/warm.py: BUDGETS); the times are this machine's, now.
+The program counts are deterministic; the tests hold each lecture to its budget
+(ikteach/course/warm.py: BUDGETS) on nbval's run of it (tests/lecture_budgets.py); the times
+are this machine's, now.
 """
 import argparse
 import sys

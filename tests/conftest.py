@@ -9,6 +9,10 @@ settings.load_profile("ikteach")
 
 
 def pytest_configure(config):
+    # a plugin, not this file's hooks: those reach only the items under tests/
+    from lecture_budgets import LectureBudgets
+
+    config.pluginmanager.register(LectureBudgets(), "ikteach-lecture-budgets")
     config.addinivalue_line("markers", "without_bwrap: its outcome depends on whether bubblewrap "
                             "works (.ci/run runs them again with bwrap hidden from PATH)")
 

@@ -31,7 +31,7 @@ turned off without changing a result.
    load from JAX's persistent compilation cache when ik.notebook.setup() turned it on
    (benchmarks/many_programs.py shows mappings and memory levelling off). MAX_PROGRAMS = 256
    is about 27,000 mappings, well under the limit, and above every lecture's budget
-   (ikteach/course/warm.py: BUDGETS; tests/test_compile_budget.py). A lower bound does not buy
+   (ikteach/course/warm.py: BUDGETS; tests/lecture_budgets.py). A lower bound does not buy
    memory where the cache is on: 10,000 varied solves held 1,554 MB with 256 and 1,575 MB with
    144 (the reloaded programs take the freed room and more), and took 40 % longer.
    IKTEACH_MAX_PROGRAMS=0 turns it off.

@@ -10,8 +10,8 @@ compiling them. The Binder image runs it at build time (binder/postBuild).
 
 For each notebook it prints how many XLA programs the run needed and where they came from:
 compiled now, or loaded from the cache. `count_programs` is the same run, returning the
-numbers (benchmarks/compile_counts.py prints them as a table; tests/test_compile_budget.py
-holds each lecture to its budget in BUDGETS).
+numbers (benchmarks/compile_counts.py prints them as a table). The tests count the same way
+on nbval's run of each lecture and hold it to its budget in BUDGETS (tests/lecture_budgets.py).
 """
 import argparse
 import json
@@ -41,7 +41,7 @@ BUDGETS = {
 }
 
 # Run in the kernel before the notebook's first cell: count JAX's own compile events.
-_COUNT_CELL = """\
+COUNT_CELL = """\
 import jax.monitoring as _ikteach_monitoring
 _ikteach_counts = {"programs": 0, "loaded": 0, "compile_s": 0.0, "trace_s": 0.0, "by_name": {}}
 def _ikteach_duration(event, seconds, fun_name="?", **kwargs):
@@ -59,7 +59,7 @@ def _ikteach_event(event, **kwargs):
 _ikteach_monitoring.register_event_duration_secs_listener(_ikteach_duration)
 _ikteach_monitoring.register_event_listener(_ikteach_event)
 """
-_REPORT_CELL = "import json as _ikteach_json; print(_ikteach_json.dumps(_ikteach_counts))"
+REPORT_CELL = "import json as _ikteach_json; print(_ikteach_json.dumps(_ikteach_counts))"
 
 
 def lectures(root=ROOT):
@@ -79,8 +79,8 @@ def count_programs(path, cache="off", timeout=900):
 
     path = Path(path)
     nb = nbformat.read(path, as_version=4)
-    nb.cells.insert(0, nbformat.v4.new_code_cell(_COUNT_CELL))
-    nb.cells.append(nbformat.v4.new_code_cell(_REPORT_CELL))
+    nb.cells.insert(0, nbformat.v4.new_code_cell(COUNT_CELL))
+    nb.cells.append(nbformat.v4.new_code_cell(REPORT_CELL))
     env = dict(os.environ, **{CACHE_ENV: str(cache)})
     start = time.perf_counter()
     client = NotebookClient(nb, timeout=timeout, kernel_name="python3",
@@ -93,10 +93,15 @@ def count_programs(path, cache="off", timeout=900):
         os.environ.clear()
         os.environ.update(saved)
     wall = time.perf_counter() - start
-    text = "".join(out.get("text", "") for out in nb.cells[-1].outputs)
-    counts = json.loads(text.strip().splitlines()[-1])
-    counts["compiled"] = counts["programs"] - counts["loaded"]
+    counts = read_counts("".join(out.get("text", "") for out in nb.cells[-1].outputs))
     counts["wall_s"] = wall
+    return counts
+
+
+def read_counts(printed):
+    """The counts REPORT_CELL printed (also read by tests/lecture_budgets.py, on nbval's run)."""
+    counts = json.loads(printed.strip().splitlines()[-1])
+    counts["compiled"] = counts["programs"] - counts["loaded"]
     return counts
 
 
