@@ -15,6 +15,8 @@ a long flat valley the extra steps gain a little more: measured, 1.02 tol from 1
 "singular" also has a clearly negative Hessian of 1/2 ||e_0||^2; "converged" - ||e|| < tol at theta;
 "max_iter" - max_iter steps taken. No solve returns NaN.
 """
+import functools
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -28,18 +30,20 @@ SEED = 40
 GAIN = 1e-3  # a gain counts above GAIN ||e|| and above tol (the statuses' definition)
 
 
-def judge_run(task, arm, rows, visible_fraction=GAIN, steps=200):
+@functools.partial(jax.jit, static_argnames=("task", "rows", "steps"))
+def judge_ends(task, rows, arm, targets, thetas, tol, steps=200):
     """A vmapped downhill run from each theta (returns where it ends): damped steps,
     ik.dls_step for one level and ik.priority_step for two, lambda adapted as in
     Levenberg-Marquardt, each step kept only when some level falls while no level before it
-    is a visible change above its start."""
+    is a visible change above its start. The arm is an argument: one program per number of
+    joints and targets, whatever the lengths."""
     rows = [jnp.asarray(r) for r in rows]
 
-    def run(target, theta, tol):
+    def run(target, theta):
         norms = lambda q: jnp.stack([jnp.linalg.norm(task.error(arm, target, q)[r]) for r in rows])
         e0 = task.error(arm, target, theta)
         start = norms(theta)
-        visible = jnp.maximum(visible_fraction * jnp.linalg.norm(e0), tol)
+        visible = jnp.maximum(GAIN * jnp.linalg.norm(e0), tol)
         sigma = jnp.linalg.norm(task.jacobian(arm, theta), 2)
 
         def step(q, lam):
@@ -59,7 +63,23 @@ def judge_run(task, arm, rows, visible_fraction=GAIN, steps=200):
 
         return jax.lax.fori_loop(0, steps, one, (theta, start, 1e-2))[0]
 
-    return jax.jit(jax.vmap(run, in_axes=(0, 0, None)))
+    return jax.vmap(run)(targets, thetas)
+
+
+@functools.partial(jax.jit, static_argnames=("task",))
+def errors(task, arm, targets, thetas):
+    return jax.vmap(lambda t, q: task.error(arm, t, q))(targets, thetas)
+
+
+@functools.partial(jax.jit, static_argnames=("task", "rows"))
+def lowest_curvatures(task, rows, arm, targets, thetas):
+    """Level 0's lowest Hessian eigenvalue of 1/2 ||e_0||^2 at each theta, over sigma_max^2."""
+    def lowest(t, q):
+        half = lambda p: 0.5 * jnp.sum(task.error(arm, t, p)[jnp.asarray(rows[0])] ** 2)
+        sigma = jnp.linalg.norm(task.jacobian(arm, q), 2)
+        return jnp.linalg.eigvalsh(jax.hessian(half)(q))[0] / sigma**2
+
+    return jax.vmap(lowest)(targets, thetas)
 
 
 def level_norms(E, rows):
@@ -69,9 +89,9 @@ def level_norms(E, rows):
 def judged(task, arm, targets, thetas, rows, tol):
     """For each row: does the judge gain (the definition above), does it gain twice that, and
     is level 0's Hessian clearly negative somewhere (a saddle)?"""
-    ends = np.asarray(judge_run(task, arm, rows)(jnp.asarray(targets), jnp.asarray(thetas), tol))
-    errors = jax.jit(jax.vmap(lambda t, q: task.error(arm, t, q)))
-    E0, E1 = np.asarray(errors(targets, thetas)), np.asarray(errors(targets, ends))
+    rows = tuple(tuple(int(i) for i in r) for r in rows)
+    ends = np.asarray(judge_ends(task, rows, arm, targets, thetas, tol))
+    E0, E1 = np.asarray(errors(task, arm, targets, thetas)), np.asarray(errors(task, arm, targets, ends))
     before, after = level_norms(E0, rows), level_norms(E1, rows)
     scale = np.linalg.norm(E0, axis=1, keepdims=True)
     fall = before - after
@@ -80,13 +100,7 @@ def judged(task, arm, targets, thetas, rows, tol):
     gain, double = (np.any((fall > m * visible) & (held > 0), axis=1) for m in (1, 2))
     reached = np.linalg.norm(E1, axis=1) < tol  # reached: a gain under either margin
     gain, double = gain | reached, double | reached
-
-    def lowest_curvature(t, q):
-        half = lambda p: 0.5 * jnp.sum(task.error(arm, t, p)[jnp.asarray(rows[0])] ** 2)
-        sigma = jnp.linalg.norm(task.jacobian(arm, q), 2)
-        return jnp.linalg.eigvalsh(jax.hessian(half)(q))[0] / sigma**2
-
-    curvature = np.asarray(jax.jit(jax.vmap(lowest_curvature))(targets, thetas))
+    curvature = np.asarray(lowest_curvatures(task, rows, arm, targets, thetas))
     return gain, double, curvature < -1e-6
 
 
@@ -94,13 +108,14 @@ def check_statuses(arm, targets, starts, res, rows, tol, max_iter=1000, solve_ag
     """Each row's status against its definition; returns the statuses (for the counts)."""
     task = task_for(arm, targets.shape[1:])
     assert np.all(np.isfinite(res.theta)) and np.all(np.isfinite(res.error))
-    E = np.asarray(jax.vmap(lambda t, q: task.error(arm, t, q))(targets, res.theta))
+    E = np.asarray(errors(task, arm, targets, res.theta))
     converged = np.linalg.norm(E, axis=1) < tol
     np.testing.assert_array_equal(res.status == "converged", converged)
     assert np.all(res.iterations[res.status == "max_iter"] == max_iter)
     looked = np.isin(res.status, ["stalled", "singular", "damped", "fixed_point", "slow"])
     if looked.any():
-        gain, big_gain, saddle = judged(task, arm, targets[looked], res.theta[looked], rows, tol)
+        # judged on every row (one program per arm size and batch), read where it looked
+        gain, big_gain, saddle = (v[looked] for v in judged(task, arm, targets, res.theta, rows, tol))
         status = res.status[looked]
         wrong = np.where(np.isin(status, ["stalled", "singular"]), big_gain, ~gain)
         wrong |= (status == "singular") & ~saddle
