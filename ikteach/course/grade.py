@@ -11,7 +11,7 @@ none works the grader refuses unless --no-sandbox), a fresh child of a fork serv
 code ran in (grading/forkserver.py), whose copy of ikteach has that exercise's answers as stubs
 that raise (grading/reference.py):
 
-1. its code cells run in IPython's shell (grading/cells.py) within --timeout s; their errors
+1. its code cells run in IPython's shell (grading/cells.py) within --timeout CPU s; their errors
    are notes, nothing they print counts;
 2. ik.check runs in the grader's own process on hidden cases (the check cell's, and as many
    drawn from a seed logged at the start: --seed repeats a run), calling the functions the
@@ -42,7 +42,7 @@ from .grading.recognise import exercise_number, identify  # noqa: F401 (grade.id
 from .grading.report import POINTS, RERUN, labels, write_results
 from .grading.submissions import notebooks, read_notebook, students, text
 
-NOTEBOOK_TIMEOUT = 120.0  # seconds for all of a student's cells
+NOTEBOOK_TIMEOUT = 120.0  # CPU seconds for all of a student's cells
 GRADE_TIMEOUT = 180.0     # seconds for a notebook's checks: every call
 GRACE = 15.0              # the fork server's kill comes first; then the grader ends it all
 MAX_NOTEBOOKS = 3 * 7      # notebooks graded per student (the rest: a note)
@@ -293,7 +293,8 @@ def main(argv=None):
     parser.add_argument("--feedback", default=None,
                         help="folder for <student>.txt (default: feedback/ next to --out)")
     parser.add_argument("--timeout", type=float, default=NOTEBOOK_TIMEOUT,
-                        help="seconds allowed for one notebook's cells (default %(default)s)")
+                        help="CPU seconds allowed for one notebook's cells, and 5 times as "
+                             "many in wall time (default %(default)s)")
     parser.add_argument("--grade-timeout", type=float, default=GRADE_TIMEOUT,
                         help="seconds allowed for one notebook's checks (default %(default)s)")
     parser.add_argument("--jobs", type=int, default=1, help="notebooks graded at once")

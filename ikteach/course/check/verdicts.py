@@ -2,14 +2,11 @@
 score by parts (_Part, _evaluate: how an exercise module uses them is in check/__init__.py),
 and word the one verdict a student sees."""
 import collections
-import contextlib
 import contextvars
 import dataclasses
 import functools
 import os
-import signal
 import sys
-import threading
 import time
 import traceback
 import warnings
@@ -17,6 +14,7 @@ import warnings
 import numpy as np
 
 from ...core.solve import StopSolve
+from ..grading.time_limit import TimeLimit, time_limit
 
 POINTS = 10
 TIME_LIMIT = 5.0    # CPU seconds for one call of a student function
@@ -30,11 +28,6 @@ _PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # ik
 
 # --- running student code safely -------------------------------------------------------------
 
-class _TimeLimit(BaseException):
-    """Raised inside student code when its time is up (BaseException: `except Exception` in
-    the student's code does not swallow it)."""
-
-
 class _NotYet(Exception):
     """The student's function still raises NotImplementedError."""
 
@@ -45,33 +38,6 @@ class _Fail(Exception):
 
 class _Abort(_Fail):
     """Stop the whole check (endless loop: trying more cases would only cost time)."""
-
-
-@contextlib.contextmanager
-def _time_limit(seconds):
-    """A limit on the student's CPU seconds (CPU_CLOCK), checked by SIGALRM in the main thread
-    (the kernel's; elsewhere no limit); a call held up BUSY times as long in wall time (a busy
-    machine, or code that waits) stops too. Raises _TimeLimit(CPU seconds, wall seconds)."""
-    if (threading.current_thread() is not threading.main_thread()
-            or not hasattr(signal, "setitimer")):
-        yield
-        return
-    clock = CPU_CLOCK.get()
-    cpu, wall = clock(), time.monotonic()
-
-    def _handler(signum, frame):
-        used, waited = clock() - cpu, time.monotonic() - wall
-        if used >= seconds or waited >= BUSY * seconds:
-            raise _TimeLimit(used, waited)
-        signal.setitimer(signal.ITIMER_REAL, max(seconds - used, 0.05))
-
-    previous = signal.signal(signal.SIGALRM, _handler)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, previous)
 
 
 def _student_line(exc):
@@ -94,10 +60,10 @@ def _call(fn, name, case, *args, limit=None):
     if not callable(fn):
         raise _Fail(f"expected your function `{name}`, got {type(fn).__name__} {fn!r:.40}")
     try:
-        with _time_limit(limit), np.errstate(all="ignore"), warnings.catch_warnings():
+        with time_limit(limit, BUSY, CPU_CLOCK.get()), np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)  # NaN is reported by the check
             return fn(*args)
-    except _TimeLimit as stop:
+    except TimeLimit as stop:
         used, waited = stop.args
         if used >= limit:
             raise _Abort(f"`{name}` did not return within {limit:g} s of CPU time on {case} - "

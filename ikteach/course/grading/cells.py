@@ -6,26 +6,23 @@ made in loops, module aliases, `from __future__` imports), not a re-reading of i
 The grader sends one JSON line on REQUESTS: {"cells": [[number, source], ...], "graded": [names],
 "timeout": s}. Cells that only call ik.check are skipped (the grader runs the checks itself).
 Before each cell a line {"cell": N} goes to REPLIES, after a cell that raised {"error": "cell N
-raised Name: value"}. The cells get `timeout` seconds in all: then the running cell is
-interrupted (SIGALRM) and the rest skipped ({"stopped": N}); a notebook that ignores the alarm
-is killed from outside by the fork server and the grader. Then {"ready": ...} (remote.serve)
-and the calls. Code objects compile as `<cell N>` (tracebacks and grading/own_code.py name them);
-a cell starting with %%time or %%capture runs as its body (their own compile names it otherwise).
-Magics run as in a kernel without a screen (`%matplotlib inline` draws into memory); shell lines
-(`!`, %pip, %conda) are skipped, and a magic that fails is a note: the rest of its cell runs.
+raised Name: value"}. The cells get `timeout` CPU seconds in all (CELLS_BUSY times as long
+in wall time): then the running cell is interrupted (SIGALRM) and the rest skipped ({"stopped":
+N, "used": [CPU s, wall s]}); a notebook that ignores the alarm is killed from outside by the
+fork server and the grader. Then {"ready": ...} (remote.serve) and the calls. Code objects
+compile as `<cell N>` (tracebacks and grading/own_code.py name them); a cell starting with
+%%time or %%capture runs as its body (their own compile names it otherwise). Magics run as in a
+kernel without a screen (`%matplotlib inline` draws into memory); shell lines (`!`, %pip,
+%conda) are skipped, and a magic that fails is a note: the rest of its cell runs.
 """
 import json
 import os
 import re
-import signal
 
 from .extract import cell_body
+from .time_limit import CELLS_BUSY, TimeLimit, time_limit
 
 MAX_TEXT = 300  # characters of an error message kept
-
-
-class NotebookTime(BaseException):
-    """Raised in the running cell when the notebook's time is up."""
 
 
 def only_checks(source):
@@ -73,35 +70,27 @@ def shell():
     return instance
 
 
-def _time_up(signum, frame):
-    raise NotebookTime()
-
-
 def run(instance, cells, send, timeout):
     """Run the cells; True when all ran, else the number of the cell the time limit stopped."""
-    signal.signal(signal.SIGALRM, _time_up)
-    signal.setitimer(signal.ITIMER_REAL, timeout)
     try:
-        for number, source in cells:
-            if only_checks(source):
-                continue
-            send({"cell": number})
-            instance.execution_count = number  # the <cell N> name (get_code_name's number)
-            result = instance.run_cell(cell_body(source), store_history=False)
-            exc = result.error_before_exec or result.error_in_exec
-            if isinstance(exc, NotebookTime):
-                send({"stopped": number})
-                return number
-            if exc is not None:
-                send({"error": error_line(number, exc)})
-            while instance.notes:
-                send({"error": f"cell {number}: {instance.notes.pop(0)}"})
-    except NotebookTime:  # between cells, or in IPython's own code
-        send({"stopped": "the end"})
+        with time_limit(timeout, CELLS_BUSY):
+            for number, source in cells:
+                if only_checks(source):
+                    continue
+                send({"cell": number})
+                instance.execution_count = number  # the <cell N> name (get_code_name's number)
+                result = instance.run_cell(cell_body(source), store_history=False)
+                exc = result.error_before_exec or result.error_in_exec
+                if isinstance(exc, TimeLimit):
+                    send({"stopped": number, "used": exc.args})
+                    return number
+                if exc is not None:
+                    send({"error": error_line(number, exc)})
+                while instance.notes:
+                    send({"error": f"cell {number}: {instance.notes.pop(0)}"})
+    except TimeLimit as exc:  # between cells, or in IPython's own code
+        send({"stopped": "the end", "used": exc.args})
         return False
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, signal.SIG_DFL)
     return True
 
 

@@ -17,6 +17,8 @@ import select
 import time
 import traceback
 
+from .time_limit import CELLS_BUSY
+
 STARTUP_LIMIT = 120.0    # seconds for the job to start (the fork server's fork: milliseconds)
 CALL_LIMIT = 600.0       # last-resort limit on one reply (the checks' own limit is shorter)
 MAX_REPLY = 64 << 20     # bytes
@@ -161,6 +163,16 @@ def serve(namespace, graded, requests, send):
 
 # --- the grader's side ------------------------------------------------------------------------------
 
+def _used(message, timeout):
+    """Why the cells' time limit stopped them (the job's "used": [CPU s, wall s])."""
+    try:
+        cpu, wall = (float(v) for v in message["used"])
+    except (KeyError, TypeError, ValueError):
+        cpu, wall = timeout, 0.0
+    held = f" in {wall:.0f} s: this machine is busy (or the notebook waits)"
+    return f"stopped after {cpu:.1f} s of CPU time{held if cpu < timeout else ''}"
+
+
 class Worker:
     """One notebook's job: a fresh child of the sandbox's fork server for `exercise`
     (servers.py: its copy of ikteach has no answer to it), started by start(): its `cells` run
@@ -185,11 +197,11 @@ class Worker:
         then say which cell it was in)."""
         from .servers import server_for
 
-        # after the job's own alarm: killed from outside (`grace` also for its start-up)
-        grace = min(GRACE, self.timeout) + GRACE
-        self.deadline = time.monotonic() + self.timeout + grace
-        self.process = server_for(self.sandbox, self.exercise).job(
-            "notebook", self.timeout + grace + self.limit, self.setup)
+        # past the job's own alarm (its cells' limit): killed from outside (`grace`: start-up too)
+        grace, held_up = min(GRACE, self.timeout) + GRACE, CELLS_BUSY * self.timeout
+        server = server_for(self.sandbox, self.exercise)  # a server's start is not the job's
+        self.deadline = time.monotonic() + held_up + grace
+        self.process = server.job("notebook", held_up + grace + self.limit, self.setup)
         cell = None
         try:
             while True:
@@ -207,9 +219,9 @@ class Worker:
                 if "error" in message and not full:
                     self.errors.append(str(message["error"])[:400])
                 if "stopped" in message and not full:
+                    why = _used(message, self.timeout)
                     self.notes.append(f"cell {str(message['stopped'])[:20]} did not finish "
-                                      "within the notebook's time limit "
-                                      f"({self.timeout:g} s): it was stopped there")
+                                      f"within the notebook's time limit: {why}")
                 cell = str(message["cell"])[:20] if "cell" in message else cell
         except BaseException:
             self.end()
@@ -234,8 +246,8 @@ class Worker:
             if not ready:
                 if left <= timeout and during == "cells":
                     raise ProcessEnded("it did not finish within the notebook's time limit "
-                                       f"({self.timeout:g} s) and ignored the alarm: it was "
-                                       "killed, and nothing could be graded")
+                                       f"({self.timeout:g} s of CPU time) and ignored the "
+                                       "alarm: it was killed, and nothing could be graded")
                 if left <= timeout:
                     raise ProcessEnded(f"your code ran past the grading time limit of "
                                        f"{self.limit:g} s: it was stopped")
