@@ -66,16 +66,15 @@ def test_the_honest_classmate_keeps_full_marks_beside_a_cpu_storm(graded):
 
 def test_shell_escapes_are_skipped_with_bounded_notes(graded):
     """40 cells of 300 `!x` lines: the grader's shell runs no shell line (issue 50: skipped, a
-    note each, at most MAX_NOTES kept), the answer is graded within the two limits (past
-    either, it would not get 10/10: the limits count CPU seconds, so no wall-clock bound here,
-    which a busy machine would break)."""
+    note each, at most MAX_NOTES kept), and the answer is graded. IPython's own transform of
+    those cells takes about 100 CPU s: --timeout stops them (that note is past the MAX_NOTES
+    kept), and since it counts CPU seconds, a busy machine does not get the job killed."""
     if graded is None:
         return
     rows, feedback, log = graded
     text = feedback["shell_escapes"]
     assert "Exercise 2 (02_jt_step.ipynb): 10/10" in text and "`!x` was skipped" in text, text
     assert text.count("was skipped") <= MAX_NOTES, text
-    assert "time limit" not in text, text
 
 
 def test_the_log_records_the_hidden_cases_seed(graded):
