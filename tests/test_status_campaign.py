@@ -24,13 +24,14 @@ import pytest
 
 import ikteach as ik
 from ikteach.core import stop_rules
+from ikteach._runtime import jit as xla
 from ikteach.core.tasks import task_for
 
 SEED = 40
 GAIN = 1e-3  # a gain counts above GAIN ||e|| and above tol (the statuses' definition)
 
 
-@functools.partial(jax.jit, static_argnames=("task", "rows", "steps"))
+@functools.partial(xla.jit, static_argnames=("task", "rows", "steps"), light=True)
 def judge_ends(task, rows, arm, targets, thetas, tol, steps=200):
     """A vmapped downhill run from each theta (returns where it ends): damped steps,
     ik.dls_step for one level and ik.priority_step for two, lambda adapted as in
@@ -66,12 +67,12 @@ def judge_ends(task, rows, arm, targets, thetas, tol, steps=200):
     return jax.vmap(run)(targets, thetas)
 
 
-@functools.partial(jax.jit, static_argnames=("task",))
+@functools.partial(xla.jit, static_argnames=("task",), light=True)
 def errors(task, arm, targets, thetas):
     return jax.vmap(lambda t, q: task.error(arm, t, q))(targets, thetas)
 
 
-@functools.partial(jax.jit, static_argnames=("task", "rows"))
+@functools.partial(xla.jit, static_argnames=("task", "rows"), light=True)
 def lowest_curvatures(task, rows, arm, targets, thetas):
     """Level 0's lowest Hessian eigenvalue of 1/2 ||e_0||^2 at each theta, over sigma_max^2."""
     def lowest(t, q):
