@@ -47,9 +47,9 @@ warm: $(STAMP)
 # Exercise templates (check cells print "not yet implemented") and the instructor's solutions.
 EXERCISES = $(wildcard notebooks/exercises/*.ipynb) $(wildcard instructor/solutions/*.ipynb)
 NOTEBOOKS = $(wildcard notebooks/*.ipynb) $(EXERCISES)
-# workers: one more than a 2-core machine's cores (many tests wait on a grader, a kernel or a
-# browser they started): 406 s against 487 s with 2, back to back (maintainers' guide)
-TEST_WORKERS ?= 3
+# workers: twice a 2-core machine's cores (many tests wait on a grader, a kernel or a browser
+# they started): compile cache empty, 496 s against 522 s with 3, back to back (maintainers' guide)
+TEST_WORKERS ?= 4
 PYTEST_ARGS = -n $(TEST_WORKERS) --dist loadfile tests $(NOTEBOOKS) --nbval --nbval-sanitize-with tests/nbval_sanitize.cfg --durations=15
 
 # The browser assets of the book and the slides (MathJax, reveal.js) and axe-core, from npm at
