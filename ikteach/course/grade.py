@@ -23,8 +23,7 @@ that raise (grading/reference.py):
 Before anyone is graded the sandbox is probed and a known-good answer must get full marks
 (grading/selfcheck.py), or the grader stops with a non-zero exit status. Writes one CSV row per
 student (ex1..ex7, total, sandbox, notes, copied) and a feedback file per student
-(grading/report.py; by default in a `feedback` folder next to the CSV).
-"""
+(grading/report.py; by default in a `feedback` folder next to the CSV)."""
 import argparse
 import collections
 import dataclasses

@@ -13,8 +13,7 @@ fork server and the grader. Then {"ready": ...} (remote.serve) and the calls. Co
 compile as `<cell N>` (tracebacks and grading/own_code.py name them); a cell starting with
 %%time or %%capture runs as its body (their own compile names it otherwise). Magics run as in a
 kernel without a screen (`%matplotlib inline` draws into memory); shell lines (`!`, %pip,
-%conda) are skipped, and a magic that fails is a note: the rest of its cell runs.
-"""
+%conda) are skipped, and a magic that fails is a note: the rest of its cell runs."""
 import json
 import os
 import re

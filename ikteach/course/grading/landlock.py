@@ -5,8 +5,7 @@ on no file outside those folders opens for writing, is made, removed or renamed,
 and all it starts - /proc and /sys included (its own oom_score_adj, /proc/sys's kernel settings,
 whatever the uid it runs as). Reading is not restricted here (bubblewrap's mount list decides
 what is there to read). On a kernel without Landlock restrict() returns False and the start-up
-probe says so in the grader's log.
-"""
+probe says so in the grader's log."""
 import ctypes
 import os
 

@@ -7,8 +7,7 @@ strings, lists, dicts, arrays as nested lists); a function the student returns (
 stays in the job and crosses as a handle; a function of ikteach that the checks pass crosses by
 its name. Whatever the job sends can only be a value of the student's own function: the verdict
 is computed here, by the checks of this process's ikteach. Everything a job says is bounded
-here (MAX_REPLY, MAX_NOTES, MAX_NAMES, MAX_HELD), however many notebooks a student hands in.
-"""
+here (MAX_REPLY, MAX_NOTES, MAX_NAMES, MAX_HELD), however many notebooks a student hands in."""
 import functools
 import importlib
 import json
@@ -167,7 +166,7 @@ def _used(message, timeout):
     """Why the cells' time limit stopped them (the job's "used": [CPU s, wall s])."""
     try:
         cpu, wall = (float(v) for v in message["used"])
-    except (KeyError, TypeError, ValueError):
+    except (KeyError, TypeError, ValueError):  # forged
         cpu, wall = timeout, 0.0
     held = f" in {wall:.0f} s: this machine is busy (or the notebook waits)"
     return f"stopped after {cpu:.1f} s of CPU time{held if cpu < timeout else ''}"
@@ -202,6 +201,7 @@ class Worker:
         server = server_for(self.sandbox, self.exercise)  # a server's start is not the job's
         self.deadline = time.monotonic() + held_up + grace
         self.process = server.job("notebook", held_up + grace + self.limit, self.setup)
+        self.cells_cpu = self.cpu_seconds() + self.timeout + grace
         cell = None
         try:
             while True:
@@ -241,10 +241,13 @@ class Worker:
         the deadline (of the cells or of the checks: `during`)."""
         fd = self.process.fileno()
         while b"\n" not in self._buffer or self.deadline < time.monotonic():
-            left = self.deadline - time.monotonic()
-            ready = left > 0 and select.select([fd], [], [], min(max(timeout, 0.0), left))[0]
-            if not ready:
-                if left <= timeout and during == "cells":
+            left, cells = self.deadline - time.monotonic(), during == "cells"
+            wait = min(max(timeout, 0.0), left, 1.0 if cells else left)
+            ready = left > 0 and select.select([fd], [], [], wait)[0]
+            if not ready:  # the cells' CPU limit from outside too: the whole sandbox, each second
+                if cells and left > 0 and self.cpu_seconds() < self.cells_cpu:
+                    continue
+                if left <= timeout and cells:
                     raise ProcessEnded("it did not finish within the notebook's time limit "
                                        f"({self.timeout:g} s of CPU time) and ignored the "
                                        "alarm: it was killed, and nothing could be graded")
