@@ -55,6 +55,14 @@ def with_answer(source):
     return book
 
 
+def with_cell(source):
+    """Exercise 2's solution notebook with a code cell `source` inserted as its second cell."""
+    book = copy.deepcopy(SOLUTION)
+    book["cells"].insert(1, {"cell_type": "code", "metadata": {}, "outputs": [],
+                             "execution_count": None, "source": source})
+    return book
+
+
 HONEST = {
     # Colab's copy: "Copy of ...", the course metadata gone
     "Copy of 02_jt_step.ipynb": without_metadata(SOLUTION),
@@ -174,10 +182,7 @@ os.setpriority(os.PRIO_PROCESS, _server, 19)
 def test_a_job_that_changes_its_fork_server_does_not_reach_the_next(sandbox):
     """prlimit and setpriority on the server (same uid): the next notebook gets a fresh one."""
     first = servers.server_for(sandbox, 2)
-    attacked = copy.deepcopy(SOLUTION)
-    attacked["cells"].insert(1, {"cell_type": "code", "metadata": {}, "outputs": [],
-                                 "execution_count": None, "source": ATTACK_SERVER})
-    grade.grade_book("attack.ipynb", attacked, 60, 120, sandbox, seed=1)
+    grade.grade_book("attack.ipynb", with_cell(ATTACK_SERVER), 60, 120, sandbox, seed=1)
     assert servers.server_for(sandbox, 2) is not first
     after = grade.grade_book("b.ipynb", SOLUTION, 60, 120, sandbox, seed=1)
     assert after["score"] == 10 and after["notes"] == [], after
@@ -198,16 +203,10 @@ def test_extended_attributes_and_acls_a_job_leaves_do_not_reach_the_next(sandbox
     """Round 5: a default ACL without rights on the fork server's folder and xattrs on /tmp and
     /dev/shm: the server is replaced, and the next notebook sees none of it."""
     first = servers.server_for(sandbox, 2)
-    attacked = copy.deepcopy(SOLUTION)
-    attacked["cells"].insert(1, {"cell_type": "code", "metadata": {}, "outputs": [],
-                                 "execution_count": None, "source": LEAVE_METADATA})
-    left = grade.grade_book("attack.ipynb", attacked, 60, 120, sandbox, seed=1)
+    left = grade.grade_book("attack.ipynb", with_cell(LEAVE_METADATA), 60, 120, sandbox, seed=1)
     assert left["notes"] == [], left  # it did set them all
     assert servers.server_for(sandbox, 2) is not first
-    honest = copy.deepcopy(SOLUTION)
-    honest["cells"].insert(1, {"cell_type": "code", "metadata": {}, "outputs": [],
-                               "execution_count": None, "source": SEES_METADATA})
-    after = grade.grade_book("b.ipynb", honest, 60, 120, sandbox, seed=1)
+    after = grade.grade_book("b.ipynb", with_cell(SEES_METADATA), 60, 120, sandbox, seed=1)
     assert after["score"] == 10 and after["notes"] == [], after
 
 
@@ -226,13 +225,6 @@ def test_times_a_job_sets_do_not_reach_the_next(sandbox):
     after = grade.grade_book("b.ipynb", with_cell(SEES_TIMES), 60, 120, sandbox, seed=1)
     assert servers.server_for(sandbox, 2) is first
     assert after["score"] == 10 and after["notes"] == [], after
-
-
-def with_cell(source):
-    book = copy.deepcopy(SOLUTION)
-    book["cells"].insert(1, {"cell_type": "code", "metadata": {}, "outputs": [],
-                             "execution_count": None, "source": source})
-    return book
 
 
 FORGED = """\
