@@ -41,7 +41,7 @@ def _total(lengths):
 
 def _sums(d, lengths, fraction):
     """The failing case's two sides of the rule, for the message."""
-    return (f"threshold: {fraction * sum(lengths):.4g}, sum |delta_theta_i| = "
+    return (f"threshold: {fraction * _total(lengths):.4g}, sum |delta_theta_i| = "
             f"{np.abs(d).sum():.4g}")
 
 
