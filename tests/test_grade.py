@@ -209,9 +209,11 @@ HOSTILE = [
     ("write_outside", 1, 10, "passed, 10/10"),
     ("fork_storm", 2, 10, "passed, 10/10"),
     ("memory_hog", 4, 10, "raised MemoryError"),
-    ("sigint_loop", 5, 10, "did not finish within the notebook's time limit: stopped after 10.0 s of CPU time"),
+    # stopped by the cells' time limit: after 10.0 s of CPU time, or a little more (or, held up on
+    # a busy machine, by the wall-clock one: tests/test_cells.py tells the two apart)
+    ("sigint_loop", 5, 10, "did not finish within the notebook's time limit: stopped after "),
     ("huge_output", 1, 10, "passed, 10/10"),
-    ("hostile", 3, 10, "did not finish within the notebook's time limit: stopped after 10.0 s of CPU time"),
+    ("hostile", 3, 10, "did not finish within the notebook's time limit: stopped after "),
     ("not_json", 1, 0, "it is not JSON"),
     ("no_functions", 3, 0, "`pinv_step` not found in the notebook"),
     # as root too: detach the checker's cover, remount / and the package, new user namespace,
