@@ -165,12 +165,15 @@ bench: $(STAMP)
 # Debian's poppler-utils: every lecture in it, no raw TeX). Not part of `make test`.
 # `make test-browser-smoke` (CI: .ci/run): every book page at 375 px, the menus, one deck.
 SUDO := $(if $(filter 0,$(shell id -u)),,sudo)
-BROWSER_PREREQS := $(STAMP) $(NODE_STAMP)
+# selenium: uv.lock's `browser` group, into the venv beside the rest
+BROWSER_STAMP := $(VENV)/.browser-stamp
+$(BROWSER_STAMP): $(STAMP)
+	$(SYNC) --group browser --quiet
+	@touch $(BROWSER_STAMP)
+BROWSER_PREREQS := $(BROWSER_STAMP) $(NODE_STAMP)
 define browser_setup
 	@test -x /usr/bin/chromium -a -x /usr/bin/chromedriver || \
 	  { $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq chromium chromium-driver; }
-	@$(PY) -c "import selenium, sys; sys.exit(tuple(map(int, selenium.__version__.split('.')[:2])) < (4, 20))" \
-	  2>/dev/null || $(PY) -m pip install --quiet "selenium>=4.20"
 endef
 test-browser: $(BROWSER_PREREQS)
 	$(browser_setup)
@@ -186,8 +189,6 @@ test-browser-smoke: $(BROWSER_PREREQS)
 
 # Browser latency (a benchmark: prints p50/p95, asserts nothing): slider -> picture redrawn
 # in JupyterLab in headless Chromium. Run on an idle machine; not part of `make test`.
-bench-browser: $(STAMP)
-	@test -x /usr/bin/chromium -a -x /usr/bin/chromedriver || \
-	  { $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq chromium chromium-driver; }
-	$(PY) -m pip install --quiet "selenium>=4.20"
+bench-browser: $(BROWSER_PREREQS)
+	$(browser_setup)
 	$(PY) tests/browser/bench_latency.py
