@@ -189,6 +189,6 @@ test-browser-smoke: $(BROWSER_PREREQS)
 
 # Browser latency (a benchmark: prints p50/p95, asserts nothing): slider -> picture redrawn
 # in JupyterLab in headless Chromium. Run on an idle machine; not part of `make test`.
-bench-browser: $(BROWSER_PREREQS)
+bench-browser: $(BROWSER_STAMP)
 	$(browser_setup)
 	$(PY) tests/browser/bench_latency.py

@@ -244,16 +244,16 @@ class Worker:
             left, cells = self.deadline - time.monotonic(), during == "cells"
             wait = min(max(timeout, 0.0), left, 1.0 if cells else left)
             ready = left > 0 and select.select([fd], [], [], wait)[0]
-            if not ready:  # the cells' CPU limit from outside too: the whole sandbox, each second
-                if cells and left > 0 and self.cpu_seconds() < self.cells_cpu:
+            if not ready and cells:  # the cells' CPU limit read from outside too, each second
+                if left > 0 and self.cpu_seconds() < self.cells_cpu:
                     continue
-                if left <= timeout and cells:
-                    raise ProcessEnded("it did not finish within the notebook's time limit "
-                                       f"({self.timeout:g} s of CPU time) and ignored the "
-                                       "alarm: it was killed, and nothing could be graded")
-                if left <= timeout:
-                    raise ProcessEnded(f"your code ran past the grading time limit of "
-                                       f"{self.limit:g} s: it was stopped")
+                raise ProcessEnded("it did not finish within the notebook's time limit "
+                                   f"({self.timeout:g} s of CPU time) and ignored the "
+                                   "alarm: it was killed, and nothing could be graded")
+            if not ready and left <= timeout:
+                raise ProcessEnded(f"your code ran past the grading time limit of "
+                                   f"{self.limit:g} s: it was stopped")
+            if not ready:
                 raise ProcessEnded(f"no answer within {timeout:g} s")
             chunk = os.read(fd, 1 << 20)
             if not chunk:
